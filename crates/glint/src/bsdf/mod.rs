@@ -1,0 +1,214 @@
+//! Scattering functions, evaluated in the local shading frame (normal = +z).
+//!
+//! # Conventions (the same everywhere in glint)
+//! - `wo` points from the surface towards the viewer (the previous path vertex); `wi` points
+//!   from the surface towards the light (the sampled next direction). Both are unit vectors
+//!   pointing *away* from the surface, in the local frame.
+//! - `eval(wo, wi)` returns the BSDF value **multiplied by |cos θi|**, i.e. the integrand of
+//!   the reflection integral apart from incident radiance (Mitsuba's convention).
+//! - `sample` returns a [`BsdfSample`] whose `weight` is `eval(wo, wi) / pdf`, already divided
+//!   by the pdf; for delta lobes `pdf` is 1 by convention and `delta` is set.
+//! - `pdf(wo, wi)` is the solid-angle density with which `sample` produces `wi`; it is 0 for
+//!   delta lobes.
+//! - Radiance is transported (camera paths), so refraction scales by (η_i/η_t)².
+//!
+//! A `Bsdf` is the material evaluated at one point: textures already looked up.
+
+mod fresnel;
+mod microfacet;
+mod phong;
+
+pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
+pub use microfacet::{Microfacet, MicrofacetKind};
+pub use phong::Phong;
+
+use crate::math::{Rgb, Vec3, INV_PI};
+use crate::sampling::warp;
+
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    /// eval(wo, wi) / pdf.
+    pub weight: Rgb,
+    pub pdf: f32,
+    /// A delta lobe was chosen (perfect mirror or refraction).
+    pub delta: bool,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum Bsdf {
+    /// Lambertian reflection.
+    Diffuse { reflectance: Rgb },
+    /// Diffuse plus a normalised Phong lobe (the Whitted integrator's glossy term).
+    Phong(Phong),
+    /// Perfectly smooth metal with complex index of refraction per channel.
+    Conductor { eta: Rgb, k: Rgb, specular: Rgb },
+    /// Microfacet metal (GGX or Beckmann).
+    RoughConductor { dist: Microfacet, eta: Rgb, k: Rgb, specular: Rgb },
+    /// Smooth glass: `eta` is n_inside / n_outside.
+    Dielectric { eta: f32, reflect: Rgb, transmit: Rgb },
+    /// Rough glass with a microfacet interface.
+    RoughDielectric { dist: Microfacet, eta: f32, reflect: Rgb, transmit: Rgb },
+    /// An infinitely thin slab of glass: reflection and straight-through transmission with
+    /// the inter-reflections summed (Mitsuba's `thindielectric`).
+    ThinDielectric { eta: f32, reflect: Rgb, transmit: Rgb },
+    /// Diffuse base under a smooth or rough dielectric coating (Mitsuba's `plastic` and
+    /// `roughplastic`), with the internal-scattering correction of the diffuse term.
+    Plastic(crate::bsdf::PlasticParams),
+    /// Absorbs everything (light sources with no material).
+    Black,
+}
+
+mod plastic;
+pub use plastic::PlasticParams;
+
+impl Bsdf {
+    /// True when every lobe is a delta: light sampling is pointless there.
+    pub fn is_delta(&self) -> bool {
+        match self {
+            Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => true,
+            Bsdf::Plastic(p) => p.is_delta_only(),
+            _ => false,
+        }
+    }
+
+    /// True when the BSDF has a delta lobe beside smooth ones (smooth plastic).
+    pub fn has_delta_lobe(&self) -> bool {
+        match self {
+            Bsdf::Plastic(p) => p.dist.is_none(),
+            _ => self.is_delta(),
+        }
+    }
+
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        match self {
+            Bsdf::Diffuse { reflectance } => {
+                if wo.z <= 0.0 || wi.z <= 0.0 {
+                    return Rgb::BLACK;
+                }
+                *reflectance * (INV_PI * wi.z)
+            }
+            Bsdf::Phong(p) => p.eval(wo, wi),
+            Bsdf::RoughConductor { dist, eta, k, specular } => {
+                if wo.z <= 0.0 || wi.z <= 0.0 {
+                    return Rgb::BLACK;
+                }
+                let h = (wo + wi).normalize();
+                let d = dist.d(h);
+                if d == 0.0 {
+                    return Rgb::BLACK;
+                }
+                let f = fresnel_conductor(wi.dot(h), *eta, *k);
+                let g = dist.g(wo, wi, h);
+                *specular * f * (d * g / (4.0 * wo.z))
+            }
+            Bsdf::RoughDielectric { dist, eta, reflect, transmit } => {
+                microfacet::eval_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
+            }
+            Bsdf::Plastic(p) => p.eval(wo, wi),
+            Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::Black => Rgb::BLACK,
+        }
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Bsdf::Diffuse { .. } => {
+                if wo.z <= 0.0 || wi.z <= 0.0 {
+                    0.0
+                } else {
+                    warp::cosine_hemisphere_pdf(wi.z)
+                }
+            }
+            Bsdf::Phong(p) => p.pdf(wo, wi),
+            Bsdf::RoughConductor { dist, .. } => {
+                if wo.z <= 0.0 || wi.z <= 0.0 {
+                    return 0.0;
+                }
+                let h = (wo + wi).normalize();
+                dist.pdf_wm(wo, h) / (4.0 * wo.dot(h))
+            }
+            Bsdf::RoughDielectric { dist, eta, reflect, transmit } => {
+                microfacet::pdf_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
+            }
+            Bsdf::Plastic(p) => p.pdf(wo, wi),
+            _ => 0.0,
+        }
+    }
+
+    /// Samples `wi` given `wo`. `u_lobe` chooses among lobes, `u` drives the direction.
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        match self {
+            Bsdf::Diffuse { reflectance } => {
+                if wo.z <= 0.0 {
+                    return None;
+                }
+                let wi = warp::cosine_hemisphere(u);
+                if wi.z <= 0.0 {
+                    return None;
+                }
+                Some(BsdfSample { wi, weight: *reflectance, pdf: warp::cosine_hemisphere_pdf(wi.z), delta: false })
+            }
+            Bsdf::Phong(p) => p.sample(wo, u_lobe, u),
+            Bsdf::Conductor { eta, k, specular } => {
+                if wo.z <= 0.0 {
+                    return None;
+                }
+                let wi = reflect_local(wo);
+                Some(BsdfSample { wi, weight: *specular * fresnel_conductor(wo.z, *eta, *k), pdf: 1.0, delta: true })
+            }
+            Bsdf::RoughConductor { dist, .. } => {
+                if wo.z <= 0.0 {
+                    return None;
+                }
+                let h = dist.sample_wm(wo, u);
+                let wi = (h * (2.0 * wo.dot(h)) - wo).normalize();
+                if wi.z <= 0.0 {
+                    return None;
+                }
+                let pdf = self.pdf(wo, wi);
+                if pdf <= 0.0 {
+                    return None;
+                }
+                Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false })
+            }
+            Bsdf::Dielectric { eta, reflect, transmit } => {
+                let fr = fresnel_dielectric(wo.z, *eta);
+                if u_lobe < fr.reflectance {
+                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true })
+                } else {
+                    let wi = refract_local(wo, &fr);
+                    let scale = 1.0 / (fr.eta_ti * fr.eta_ti);
+                    Some(BsdfSample { wi, weight: *transmit * scale, pdf: 1.0, delta: true })
+                }
+            }
+            Bsdf::ThinDielectric { eta, reflect, transmit } => {
+                let mut r = fresnel_dielectric(wo.z.abs(), *eta).reflectance;
+                // Sum of the geometric series of internal bounces (Mitsuba thindielectric).
+                if r < 1.0 {
+                    r *= 2.0 / (1.0 + r);
+                }
+                if u_lobe < r {
+                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true })
+                } else {
+                    Some(BsdfSample { wi: -wo, weight: *transmit, pdf: 1.0, delta: true })
+                }
+            }
+            Bsdf::RoughDielectric { dist, eta, reflect, transmit } => {
+                microfacet::sample_rough_dielectric(dist, *eta, *reflect, *transmit, wo, u_lobe, u)
+            }
+            Bsdf::Plastic(p) => p.sample(wo, u_lobe, u),
+            Bsdf::Black => None,
+        }
+    }
+
+    /// Fraction of light reflected and transmitted (for the Whitted integrator's mix);
+    /// the delta directions themselves come from `sample`.
+    pub fn diffuse_reflectance(&self) -> Rgb {
+        match self {
+            Bsdf::Diffuse { reflectance } => *reflectance,
+            Bsdf::Phong(p) => p.kd,
+            Bsdf::Plastic(p) => p.diffuse,
+            _ => Rgb::BLACK,
+        }
+    }
+}

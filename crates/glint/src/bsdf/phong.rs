@@ -1,0 +1,76 @@
+//! Diffuse + normalised Phong lobe (Lafortune and Willems 1994): energy-conserving when
+//! kd + ks <= 1, so the same material works in the Whitted and the path tracer.
+
+use super::{reflect_local, BsdfSample};
+use crate::math::{Frame, Rgb, Vec3, INV_PI, PI};
+use crate::sampling::warp;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Phong {
+    pub kd: Rgb,
+    pub ks: Rgb,
+    pub exponent: f32,
+}
+
+impl Phong {
+    fn specular_probability(&self) -> f32 {
+        let d = self.kd.average();
+        let s = self.ks.average();
+        if d + s <= 0.0 {
+            0.0
+        } else {
+            s / (d + s)
+        }
+    }
+
+    /// The specular lobe's value without the cosine: (n+2)/(2π) cos^n α.
+    pub fn lobe(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let cos_alpha = reflect_local(wo).dot(wi);
+        if cos_alpha <= 0.0 {
+            0.0
+        } else {
+            (self.exponent + 2.0) * 0.5 * INV_PI * cos_alpha.powf(self.exponent)
+        }
+    }
+
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::BLACK;
+        }
+        (self.kd * INV_PI + self.ks * self.lobe(wo, wi)) * wi.z
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let ps = self.specular_probability();
+        let cos_alpha = reflect_local(wo).dot(wi).max(0.0);
+        let spec = (self.exponent + 1.0) * 0.5 * INV_PI * cos_alpha.powf(self.exponent);
+        ps * spec + (1.0 - ps) * warp::cosine_hemisphere_pdf(wi.z)
+    }
+
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = if u_lobe < self.specular_probability() {
+            // cos^n lobe around the mirror direction: cos α = u^(1/(n+1)).
+            let cos_a = u[0].powf(1.0 / (self.exponent + 1.0));
+            let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+            let phi = 2.0 * PI * u[1];
+            let local = Vec3 { x: sin_a * phi.cos(), y: sin_a * phi.sin(), z: cos_a };
+            Frame::from_normal(reflect_local(wo)).to_world(local)
+        } else {
+            warp::cosine_hemisphere(u)
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wo, wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false })
+    }
+}

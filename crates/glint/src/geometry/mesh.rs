@@ -1,0 +1,209 @@
+//! Triangle meshes with their own bottom-level BVH.
+
+use crate::accel::{intersect_triangle, Bvh, BvhSplit, ShearedRay, TriangleHit};
+use crate::math::{Aabb, Ray, Vec3};
+
+#[derive(Clone, Debug, Default)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals, if the file had them.
+    pub normals: Option<Vec<Vec3>>,
+    pub uvs: Option<Vec<[f32; 2]>>,
+    pub indices: Vec<[u32; 3]>,
+    pub bvh: Bvh,
+}
+
+impl TriangleMesh {
+    /// Validates indices and builds the BVH. Errors name the first bad triangle.
+    pub fn new(
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<[f32; 2]>>,
+        indices: Vec<[u32; 3]>,
+        split: BvhSplit,
+    ) -> Result<TriangleMesh, String> {
+        let n = positions.len() as u32;
+        if let Some((i, t)) = indices.iter().enumerate().find(|(_, t)| t.iter().any(|&v| v >= n)) {
+            return Err(format!("triangle {i} uses vertex {:?} but the mesh has {n} vertices", t));
+        }
+        if let Some(ns) = &normals {
+            if ns.len() != positions.len() {
+                return Err(format!("{} normals for {} vertices", ns.len(), positions.len()));
+            }
+        }
+        if let Some(uv) = &uvs {
+            if uv.len() != positions.len() {
+                return Err(format!("{} texture coordinates for {} vertices", uv.len(), positions.len()));
+            }
+        }
+        if let Some(p) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!("vertex {p} is not finite"));
+        }
+        let mut mesh = TriangleMesh { positions, normals, uvs, indices, bvh: Bvh::default() };
+        mesh.build_bvh(split);
+        Ok(mesh)
+    }
+
+    pub fn build_bvh(&mut self, split: BvhSplit) {
+        let bounds: Vec<Aabb> = (0..self.indices.len()).map(|i| self.triangle_bounds(i)).collect();
+        self.bvh = Bvh::build(&bounds, split);
+    }
+
+    #[inline(always)]
+    pub fn vertices(&self, tri: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[tri];
+        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+    }
+
+    fn triangle_bounds(&self, tri: usize) -> Aabb {
+        let [a, b, c] = self.vertices(tri);
+        let bb = Aabb::from_points(&[a, b, c]);
+        // A degenerate (zero-area) triangle cannot be hit; keep it out of the way of the SAH.
+        if (b - a).cross(c - a).length_squared() == 0.0 {
+            Aabb::EMPTY
+        } else {
+            bb
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
+    pub fn triangle_area(&self, tri: usize) -> f32 {
+        let [a, b, c] = self.vertices(tri);
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// Closest hit: (triangle, hit). Shortens `ray.t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
+        let sh = ShearedRay::new(ray.dir);
+        let mut best = None;
+        self.bvh.traverse(ray, |tri, r| {
+            let [a, b, c] = self.vertices(tri as usize);
+            if let Some(h) = intersect_triangle(r, &sh, a, b, c) {
+                r.t_max = h.t;
+                best = Some((tri, h));
+                true
+            } else {
+                false
+            }
+        });
+        best
+    }
+
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let sh = ShearedRay::new(ray.dir);
+        self.bvh.occluded(ray, |tri, r| {
+            let [a, b, c] = self.vertices(tri as usize);
+            intersect_triangle(r, &sh, a, b, c).is_some()
+        })
+    }
+
+    /// Closest hit by testing every triangle: the reference that the BVH must agree with.
+    pub fn intersect_brute_force(&self, ray: &Ray) -> Option<(u32, TriangleHit)> {
+        let sh = ShearedRay::new(ray.dir);
+        let mut r = *ray;
+        let mut best = None;
+        for tri in 0..self.indices.len() {
+            let [a, b, c] = self.vertices(tri);
+            if let Some(h) = intersect_triangle(&r, &sh, a, b, c) {
+                r.t_max = h.t;
+                best = Some((tri as u32, h));
+            }
+        }
+        best
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        self.positions.len() * 12
+            + self.normals.as_ref().map_or(0, |n| n.len() * 12)
+            + self.uvs.as_ref().map_or(0, |n| n.len() * 8)
+            + self.indices.len() * 12
+    }
+}
+
+/// Quad (p0, p1, p2, p3 in order) as a two-triangle mesh with uv (0,0)..(1,1).
+pub fn quad_mesh(p: [Vec3; 4], split: BvhSplit) -> TriangleMesh {
+    let uvs = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    TriangleMesh::new(p.to_vec(), None, Some(uvs), vec![[0, 1, 2], [0, 2, 3]], split).expect("valid quad")
+}
+
+/// Axis-aligned cube [-1, 1]^3 with outward faces (Mitsuba's `cube`), 24 vertices so that
+/// each face has its own uv square.
+pub fn cube_mesh(split: BvhSplit) -> TriangleMesh {
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    let mut indices = Vec::new();
+    // Each face: normal axis, sign; two tangent axes chosen so (t1 x t2) = outward normal.
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut n = [0.0f32; 3];
+            n[axis] = sign;
+            let n = Vec3::from_array(n);
+            let t1 = Vec3::from_array({
+                let mut t = [0.0f32; 3];
+                t[(axis + 1) % 3] = 1.0;
+                t
+            });
+            let t2 = n.cross(t1);
+            let base = positions.len() as u32;
+            for (u, v) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                positions.push(n + t1 * u + t2 * v);
+                uvs.push([(u + 1.0) * 0.5, (v + 1.0) * 0.5]);
+            }
+            indices.push([base, base + 1, base + 2]);
+            indices.push([base, base + 2, base + 3]);
+        }
+    }
+    TriangleMesh::new(positions, None, Some(uvs), indices, split).expect("valid cube")
+}
+
+/// Unit disk in the z = 0 plane facing +z, as a fan of `segments` triangles.
+pub fn disk_mesh(segments: u32, split: BvhSplit) -> TriangleMesh {
+    let mut positions = vec![Vec3::ZERO];
+    let mut uvs = vec![[0.5, 0.5]];
+    for i in 0..segments {
+        let phi = 2.0 * std::f32::consts::PI * i as f32 / segments as f32;
+        positions.push(Vec3 { x: phi.cos(), y: phi.sin(), z: 0.0 });
+        uvs.push([0.5 + 0.5 * phi.cos(), 0.5 + 0.5 * phi.sin()]);
+    }
+    let indices = (0..segments).map(|i| [0, 1 + i, 1 + (i + 1) % segments]).collect();
+    TriangleMesh::new(positions, None, Some(uvs), indices, split).expect("valid disk")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::vec3;
+
+    #[test]
+    fn cube_faces_point_outwards() {
+        let cube = cube_mesh(BvhSplit::Sah);
+        for t in 0..cube.indices.len() {
+            let [a, b, c] = cube.vertices(t);
+            let n = (b - a).cross(c - a);
+            let centre = (a + b + c) / 3.0;
+            assert!(n.dot(centre) > 0.0, "face {t} points inwards");
+        }
+    }
+
+    #[test]
+    fn out_of_range_index_is_an_error() {
+        let e = TriangleMesh::new(vec![Vec3::ZERO; 3], None, None, vec![[0, 1, 3]], BvhSplit::Sah);
+        assert!(e.unwrap_err().contains("vertex"));
+    }
+
+    #[test]
+    fn quad_is_hit_in_the_middle() {
+        let q = quad_mesh(
+            [vec3(-1.0, -1.0, 0.0), vec3(1.0, -1.0, 0.0), vec3(1.0, 1.0, 0.0), vec3(-1.0, 1.0, 0.0)],
+            BvhSplit::Sah,
+        );
+        let mut r = Ray::new(vec3(0.0, 0.0, 5.0), vec3(0.0, 0.0, -1.0));
+        let (_, h) = q.intersect(&mut r).unwrap();
+        assert!((h.t - 5.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,7 @@
+//! Shapes: triangle meshes (with their own BVH) and analytic spheres.
+
+mod mesh;
+mod sphere;
+
+pub use mesh::{cube_mesh, disk_mesh, quad_mesh, TriangleMesh};
+pub use sphere::Sphere;

@@ -1,0 +1,77 @@
+//! Integrators: estimate the radiance arriving along a camera ray.
+//!
+//! Each integrator has serialisable settings and a per-ray `li`; scheduling of pixels and
+//! threads lives in [`crate::render`], so integrators never see threads.
+
+mod path;
+mod whitted;
+
+pub use path::{PathSettings, Strategy};
+pub use whitted::WhittedSettings;
+
+use crate::bsdf::Bsdf;
+use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
+use crate::sampling::Rng;
+use crate::scene::{Scene, SurfaceInteraction};
+
+/// Per-thread counters, summed at the end of a render.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Counters {
+    pub rays: u64,
+    pub shadow_rays: u64,
+}
+
+#[derive(Clone, Debug)]
+pub enum Integrator {
+    Whitted(WhittedSettings),
+    Path(PathSettings),
+}
+
+impl Integrator {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Whitted(_) => "whitted",
+            Integrator::Path(_) => "path",
+        }
+    }
+
+    #[inline]
+    pub fn li(&self, scene: &Scene, ray: &Ray, rng: &mut Rng, counters: &mut Counters) -> Rgb {
+        match self {
+            Integrator::Whitted(s) => whitted::li(s, scene, ray, rng, counters),
+            Integrator::Path(s) => path::li(s, scene, ray, rng, counters),
+        }
+    }
+}
+
+/// The BSDF at a hit and the frame to evaluate it in. Two-sided opaque materials turn
+/// their frame to face the viewer; one-sided ones (Mitsuba's default) keep it, so their back
+/// face is black; dielectrics keep it, since which side is inside matters to them.
+pub(crate) fn shading(scene: &Scene, si: &SurfaceInteraction, wo_world: Vec3) -> (Bsdf, Frame) {
+    let mat = &scene.materials[si.material as usize];
+    let bsdf = mat.bsdf(si.uv);
+    let mut frame = si.frame;
+    if mat.two_sided && !mat.is_transmissive() && frame.n.dot(wo_world) < 0.0 {
+        frame = Frame { s: frame.s, t: -frame.t, n: -frame.n };
+    }
+    (bsdf, frame)
+}
+
+/// A ray leaving the surface at `si` in direction `dir`, offset off the surface.
+#[inline]
+pub(crate) fn spawn_ray(si: &SurfaceInteraction, dir: Vec3) -> Ray {
+    Ray::new(offset_origin(si.p, si.ng, dir), dir)
+}
+
+/// A shadow ray from `si` towards a point `dist` away along `dir` (stops just short of it).
+#[inline]
+pub(crate) fn shadow_ray(si: &SurfaceInteraction, dir: Vec3, dist: f32) -> Ray {
+    let o = offset_origin(si.p, si.ng, dir);
+    let t_max = if dist.is_finite() {
+        let remaining = dist - (o - si.p).dot(dir);
+        remaining * (1.0 - 1e-4)
+    } else {
+        f32::INFINITY
+    };
+    Ray::segment(o, dir, t_max)
+}

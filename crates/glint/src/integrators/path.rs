@@ -1,0 +1,189 @@
+//! Unidirectional path tracing with next-event estimation and multiple importance
+//! sampling (power heuristic), Russian roulette on the path throughput, and unbounded depth
+//! by default. Depth counts path segments, as Mitsuba's `max_depth` does: 1 shows emitters
+//! seen directly, 2 adds direct lighting, and so on.
+
+use super::{shading, shadow_ray, spawn_ray, Counters};
+use crate::math::{Ray, Rgb};
+use crate::sampling::{power_heuristic, Rng};
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+
+/// Which estimators contribute; all three converge to the same image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Strategy {
+    /// Light sampling and BSDF sampling combined by MIS (the default).
+    #[default]
+    Mis,
+    /// Light sampling only (emitters hit by BSDF rays count only after delta bounces).
+    Light,
+    /// BSDF sampling only (no shadow rays).
+    Bsdf,
+}
+
+impl std::str::FromStr for Strategy {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "mis" => Ok(Strategy::Mis),
+            "light" => Ok(Strategy::Light),
+            "bsdf" => Ok(Strategy::Bsdf),
+            _ => Err(format!("unknown strategy '{s}' (expected mis, light or bsdf)")),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PathSettings {
+    /// Longest path in segments; `None` is unbounded.
+    pub max_depth: Option<u32>,
+    /// Depth (segments) from which Russian roulette may end paths.
+    pub rr_depth: u32,
+    /// A fixed survival probability (the paper's P) instead of the throughput-based one.
+    pub rr_probability: Option<f32>,
+    pub strategy: Strategy,
+    /// Do not show emitters seen directly by the camera.
+    pub hide_emitters: bool,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings {
+            max_depth: None,
+            rr_depth: 5,
+            rr_probability: None,
+            strategy: Strategy::Mis,
+            hide_emitters: false,
+        }
+    }
+}
+
+pub fn li(s: &PathSettings, scene: &Scene, camera_ray: &Ray, rng: &mut Rng, c: &mut Counters) -> Rgb {
+    let max_depth = s.max_depth.unwrap_or(u32::MAX);
+    if max_depth == 0 {
+        return Rgb::BLACK;
+    }
+    let mut l = Rgb::BLACK;
+    let mut throughput = Rgb::WHITE;
+    let mut ray = *camera_ray;
+    // Density of the BSDF sample that produced `ray` (solid angle) and whether it was delta;
+    // the camera ray behaves like a delta sample (nothing else could have produced it).
+    let mut prev_pdf = 1.0f32;
+    let mut prev_delta = true;
+    let mut prev_p = ray.origin;
+    let mut depth = 0u32; // segments traced so far
+
+    loop {
+        c.rays += 1;
+        let hit = scene.intersect(&ray);
+        depth += 1;
+        let Some(hit) = hit else {
+            if !(depth == 1 && s.hide_emitters) {
+                for &li_idx in &scene.environment_lights {
+                    let light = &scene.lights[li_idx as usize];
+                    let le = light.environment(ray.dir);
+                    if le.is_black() {
+                        continue;
+                    }
+                    let w = emitter_weight(s.strategy, prev_delta, prev_pdf, || {
+                        scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, ray.origin, ray.dir)
+                    });
+                    l += throughput * le * w;
+                }
+            }
+            break;
+        };
+        let si = scene.interaction(&ray, &hit);
+
+        if let Some(li_idx) = si.light {
+            if !(depth == 1 && s.hide_emitters) {
+                let light = &scene.lights[li_idx as usize];
+                let le = light.emitted(si.ng, ray.dir);
+                if !le.is_black() {
+                    let w = emitter_weight(s.strategy, prev_delta, prev_pdf, || {
+                        scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, si.p, si.ng)
+                    });
+                    l += throughput * le * w;
+                }
+            }
+        }
+        if depth >= max_depth {
+            break;
+        }
+
+        let wo_world = -ray.dir;
+        let (bsdf, frame) = shading(scene, &si, wo_world);
+        let wo = frame.to_local(wo_world);
+
+        // Next-event estimation: one light, chosen by the scene's light distribution.
+        if s.strategy != Strategy::Bsdf && !bsdf.is_delta() {
+            if let Some(dist) = &scene.light_distribution {
+                let pick = dist.sample(rng.next_f32());
+                let light = &scene.lights[pick.index];
+                let u = rng.next_2d();
+                if let Some(ls) = light.sample_li(si.p, u) {
+                    if ls.pdf > 0.0 && !ls.radiance.is_black() {
+                        let wi = frame.to_local(ls.wi);
+                        let f = bsdf.eval(wo, wi);
+                        if !f.is_black() {
+                            c.shadow_rays += 1;
+                            if !scene.occluded(&shadow_ray(&si, ls.wi, ls.dist)) {
+                                let light_pdf = pick.pmf * ls.pdf;
+                                let w = if ls.delta || s.strategy == Strategy::Light {
+                                    1.0
+                                } else {
+                                    power_heuristic(light_pdf, bsdf.pdf(wo, wi))
+                                };
+                                l += throughput * f * ls.radiance * (w / light_pdf);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        // Continue the path by sampling the BSDF.
+        let u_lobe = rng.next_f32();
+        let u = rng.next_2d();
+        let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
+            break;
+        };
+        if bs.weight.is_black() {
+            break;
+        }
+        throughput *= bs.weight;
+        let wi_world = frame.to_world(bs.wi);
+        prev_pdf = bs.pdf;
+        prev_delta = bs.delta;
+        prev_p = si.p;
+        ray = spawn_ray(&si, wi_world);
+
+        if depth >= s.rr_depth {
+            let q = match s.rr_probability {
+                Some(p) => p,
+                None => throughput.max_component().min(0.95),
+            };
+            if q <= 0.0 || rng.next_f32() >= q {
+                break;
+            }
+            throughput = throughput / q;
+        }
+    }
+    l
+}
+
+/// MIS weight of an emitter reached by a BSDF-sampled ray. `light_pdf` is only evaluated
+/// when needed (it costs a distribution lookup).
+#[inline]
+fn emitter_weight(strategy: Strategy, prev_delta: bool, prev_pdf: f32, light_pdf: impl FnOnce() -> f32) -> f32 {
+    if prev_delta {
+        return 1.0;
+    }
+    match strategy {
+        Strategy::Bsdf => 1.0,
+        Strategy::Light => 0.0,
+        Strategy::Mis => power_heuristic(prev_pdf, light_pdf()),
+    }
+}

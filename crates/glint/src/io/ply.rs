@@ -1,0 +1,335 @@
+//! PLY reader (ASCII, binary little- and big-endian): vertex positions, optional normals
+//! and texture coordinates, and faces as lists (fan-triangulated). Errors name the file and,
+//! for the header and ASCII bodies, the line.
+
+use crate::math::Vec3;
+use std::path::Path;
+
+#[derive(Clone, Debug, Default)]
+pub struct PlyMesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Option<Vec<Vec3>>,
+    pub uvs: Option<Vec<[f32; 2]>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Format {
+    Ascii,
+    BinaryLe,
+    BinaryBe,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(s: &str) -> Option<Scalar> {
+        Some(match s {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Property {
+    name: String,
+    ty: Scalar,
+    /// Some(count type) for list properties.
+    list: Option<Scalar>,
+}
+
+#[derive(Clone, Debug)]
+struct Element {
+    name: String,
+    count: usize,
+    props: Vec<Property>,
+}
+
+struct Reader<'a> {
+    data: &'a [u8],
+    pos: usize,
+    format: Format,
+    /// ASCII tokens of the body with their line numbers.
+    tokens: Vec<(&'a str, usize)>,
+    tok: usize,
+}
+
+impl Reader<'_> {
+    fn read(&mut self, ty: Scalar, path: &Path) -> Result<f64, String> {
+        match self.format {
+            Format::Ascii => {
+                let Some(&(t, line)) = self.tokens.get(self.tok) else {
+                    return Err(format!("{}: file ends early (truncated body)", path.display()));
+                };
+                self.tok += 1;
+                t.parse::<f64>().map_err(|_| format!("{}:{}: '{}' is not a number", path.display(), line, t))
+            }
+            _ => {
+                let n = ty.size();
+                if self.pos + n > self.data.len() {
+                    return Err(format!("{}: file ends early (truncated binary body)", path.display()));
+                }
+                let b = &self.data[self.pos..self.pos + n];
+                self.pos += n;
+                let le = self.format == Format::BinaryLe;
+                macro_rules! get {
+                    ($t:ty) => {{
+                        let arr: [u8; std::mem::size_of::<$t>()] = b.try_into().unwrap();
+                        if le {
+                            <$t>::from_le_bytes(arr) as f64
+                        } else {
+                            <$t>::from_be_bytes(arr) as f64
+                        }
+                    }};
+                }
+                Ok(match ty {
+                    Scalar::I8 => b[0] as i8 as f64,
+                    Scalar::U8 => b[0] as f64,
+                    Scalar::I16 => get!(i16),
+                    Scalar::U16 => get!(u16),
+                    Scalar::I32 => get!(i32),
+                    Scalar::U32 => get!(u32),
+                    Scalar::F32 => get!(f32),
+                    Scalar::F64 => get!(f64),
+                })
+            }
+        }
+    }
+}
+
+pub fn read_ply(path: &Path) -> Result<PlyMesh, String> {
+    let data = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse_ply(&data, path)
+}
+
+pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
+    let p = path.display();
+    // Header: lines up to "end_header".
+    let mut pos = 0;
+    let mut line_no = 0;
+    let mut format = None;
+    let mut elements: Vec<Element> = Vec::new();
+    let mut first = true;
+    loop {
+        let end = data[pos..]
+            .iter()
+            .position(|&c| c == b'\n')
+            .ok_or_else(|| format!("{p}: header has no 'end_header' (truncated or not a PLY file)"))?;
+        let line = String::from_utf8_lossy(&data[pos..pos + end]).trim().to_string();
+        pos += end + 1;
+        line_no += 1;
+        if first {
+            if line != "ply" {
+                return Err(format!("{p}:1: not a PLY file (first line is not 'ply')"));
+            }
+            first = false;
+            continue;
+        }
+        let parts: Vec<&str> = line.split_whitespace().collect();
+        match parts.first().copied() {
+            Some("format") => {
+                format = Some(match parts.get(1).copied() {
+                    Some("ascii") => Format::Ascii,
+                    Some("binary_little_endian") => Format::BinaryLe,
+                    Some("binary_big_endian") => Format::BinaryBe,
+                    other => return Err(format!("{p}:{line_no}: unknown PLY format {:?}", other.unwrap_or(""))),
+                })
+            }
+            Some("element") => {
+                let (Some(name), Some(count)) = (parts.get(1), parts.get(2).and_then(|c| c.parse().ok())) else {
+                    return Err(format!("{p}:{line_no}: malformed element line"));
+                };
+                elements.push(Element { name: name.to_string(), count, props: Vec::new() });
+            }
+            Some("property") => {
+                let el = elements.last_mut().ok_or_else(|| format!("{p}:{line_no}: property before any element"))?;
+                let bad = || format!("{p}:{line_no}: malformed property line");
+                if parts.get(1) == Some(&"list") {
+                    let ct = parts.get(2).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
+                    let ty = parts.get(3).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
+                    let name = parts.get(4).ok_or_else(bad)?;
+                    el.props.push(Property { name: name.to_string(), ty, list: Some(ct) });
+                } else {
+                    let ty = parts.get(1).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
+                    let name = parts.get(2).ok_or_else(bad)?;
+                    el.props.push(Property { name: name.to_string(), ty, list: None });
+                }
+            }
+            Some("end_header") => break,
+            Some("comment") | Some("obj_info") | None => {}
+            Some(other) => return Err(format!("{p}:{line_no}: unexpected header keyword '{other}'")),
+        }
+    }
+    let format = format.ok_or_else(|| format!("{p}: header has no 'format' line"))?;
+    let body = &data[pos..];
+    let tokens = if format == Format::Ascii {
+        let text = std::str::from_utf8(body).map_err(|_| format!("{p}: ASCII body is not text"))?;
+        text.lines().enumerate().flat_map(|(i, l)| l.split_whitespace().map(move |t| (t, line_no + 1 + i))).collect()
+    } else {
+        Vec::new()
+    };
+    let mut r = Reader { data: body, pos: 0, format, tokens, tok: 0 };
+
+    let mut mesh = PlyMesh::default();
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    for el in &elements {
+        let idx = |n: &[&str]| el.props.iter().position(|pr| n.contains(&pr.name.as_str()));
+        match el.name.as_str() {
+            "vertex" => {
+                let (x, y, z) = (idx(&["x"]), idx(&["y"]), idx(&["z"]));
+                let (Some(x), Some(y), Some(z)) = (x, y, z) else {
+                    return Err(format!("{p}: vertex element lacks x, y or z"));
+                };
+                let (nx, ny, nz) = (idx(&["nx"]), idx(&["ny"]), idx(&["nz"]));
+                let (u, v) = (idx(&["u", "s", "texture_u", "texture_s"]), idx(&["v", "t", "texture_v", "texture_t"]));
+                let mut vals = vec![0.0f64; el.props.len()];
+                for _ in 0..el.count {
+                    for (k, pr) in el.props.iter().enumerate() {
+                        if let Some(ct) = pr.list {
+                            let n = r.read(ct, path)? as usize;
+                            for _ in 0..n {
+                                r.read(pr.ty, path)?;
+                            }
+                        } else {
+                            vals[k] = r.read(pr.ty, path)?;
+                        }
+                    }
+                    mesh.positions.push(Vec3 { x: vals[x] as f32, y: vals[y] as f32, z: vals[z] as f32 });
+                    if let (Some(a), Some(b), Some(c)) = (nx, ny, nz) {
+                        normals.push(Vec3 { x: vals[a] as f32, y: vals[b] as f32, z: vals[c] as f32 });
+                    }
+                    if let (Some(a), Some(b)) = (u, v) {
+                        uvs.push([vals[a] as f32, vals[b] as f32]);
+                    }
+                }
+            }
+            "face" => {
+                let list = el
+                    .props
+                    .iter()
+                    .position(|pr| pr.list.is_some() && (pr.name == "vertex_indices" || pr.name == "vertex_index"))
+                    .ok_or_else(|| format!("{p}: face element has no vertex_indices list"))?;
+                for f in 0..el.count {
+                    for (k, pr) in el.props.iter().enumerate() {
+                        if let Some(ct) = pr.list {
+                            let n = r.read(ct, path)? as usize;
+                            let mut ids = Vec::with_capacity(n);
+                            for _ in 0..n {
+                                ids.push(r.read(pr.ty, path)?);
+                            }
+                            if k == list {
+                                if n < 3 {
+                                    return Err(format!("{p}: face {f} has {n} vertices (needs 3 or more)"));
+                                }
+                                let nv = mesh.positions.len();
+                                for &i in &ids {
+                                    if i < 0.0 || i as usize >= nv {
+                                        return Err(format!(
+                                            "{p}: face {f} uses vertex {i} but there are {nv} vertices"
+                                        ));
+                                    }
+                                }
+                                for t in 1..n - 1 {
+                                    mesh.indices.push([ids[0] as u32, ids[t] as u32, ids[t + 1] as u32]);
+                                }
+                            }
+                        } else {
+                            r.read(pr.ty, path)?;
+                        }
+                    }
+                }
+            }
+            _ => {
+                for _ in 0..el.count {
+                    for pr in &el.props {
+                        if let Some(ct) = pr.list {
+                            let n = r.read(ct, path)? as usize;
+                            for _ in 0..n {
+                                r.read(pr.ty, path)?;
+                            }
+                        } else {
+                            r.read(pr.ty, path)?;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if mesh.indices.is_empty() {
+        return Err(format!("{p}: no faces"));
+    }
+    if !normals.is_empty() {
+        mesh.normals = Some(normals);
+    }
+    if !uvs.is_empty() {
+        mesh.uvs = Some(uvs);
+    }
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ASCII: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+
+    #[test]
+    fn ascii_quad() {
+        let m = parse_ply(ASCII.as_bytes(), Path::new("a.ply")).unwrap();
+        assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn binary_matches_ascii() {
+        let mut data = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n".to_vec();
+        for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in v {
+                data.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        data.push(3);
+        for i in [0u32, 1, 2] {
+            data.extend_from_slice(&i.to_le_bytes());
+        }
+        let m = parse_ply(&data, Path::new("b.ply")).unwrap();
+        assert_eq!(m.positions[1].x, 1.0);
+        assert_eq!(m.indices, vec![[0, 1, 2]]);
+        // Truncated: drop the last index.
+        let e = parse_ply(&data[..data.len() - 2], Path::new("b.ply")).unwrap_err();
+        assert!(e.contains("b.ply") && e.contains("truncated"), "{e}");
+    }
+
+    #[test]
+    fn out_of_range_index_is_reported() {
+        let bad = ASCII.replace("4 0 1 2 3", "3 0 1 9");
+        let e = parse_ply(bad.as_bytes(), Path::new("a.ply")).unwrap_err();
+        assert!(e.contains("vertex 9"), "{e}");
+    }
+}

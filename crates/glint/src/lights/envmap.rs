@@ -1,0 +1,99 @@
+//! Environment maps in latitude-longitude layout, importance-sampled by luminance × sin θ.
+
+use super::LightSample;
+use crate::materials::Bitmap;
+use crate::math::{Rgb, Transform, Vec3, PI};
+use crate::sampling::Distribution1d;
+
+#[derive(Clone, Debug)]
+pub struct EnvMap {
+    pub image: Bitmap,
+    pub scale: f32,
+    /// Environment-to-world rotation.
+    pub to_world: Transform,
+    pub scene_radius: f32,
+    rows: Distribution1d,
+    cols: Vec<Distribution1d>,
+}
+
+impl EnvMap {
+    pub fn new(image: Bitmap, scale: f32, to_world: Transform, scene_radius: f32) -> Result<EnvMap, String> {
+        let (w, h) = (image.width, image.height);
+        let mut cols = Vec::with_capacity(h);
+        let mut row_weights = Vec::with_capacity(h);
+        for y in 0..h {
+            let sin_t = (PI * (y as f32 + 0.5) / h as f32).sin();
+            let weights: Vec<f32> = (0..w).map(|x| image.pixels[y * w + x].luminance().max(0.0) * sin_t).collect();
+            let sum: f32 = weights.iter().sum();
+            row_weights.push(sum);
+            // A black row is never chosen, but keep a valid distribution for it.
+            cols.push(Distribution1d::new(&weights).unwrap_or_else(|| Distribution1d::new(&vec![1.0; w]).unwrap()));
+        }
+        let rows = Distribution1d::new(&row_weights).ok_or("the environment map is black everywhere")?;
+        Ok(EnvMap { image, scale, to_world, scene_radius, rows, cols })
+    }
+
+    pub fn mean_luminance(&self) -> f32 {
+        self.image.mean().luminance() * self.scale
+    }
+
+    /// Direction (world) to pixel-space (u, v) in [0,1)^2. Mitsuba's layout: +y is up, u
+    /// grows with azimuth measured from +x towards... see `dir_from_uv`.
+    fn uv_from_dir(&self, d_world: Vec3) -> [f32; 2] {
+        let d = self.to_world.inv_vector(d_world).normalize();
+        let theta = d.y.clamp(-1.0, 1.0).acos();
+        let mut phi = d.x.atan2(-d.z);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        [phi / (2.0 * PI), theta / PI]
+    }
+
+    fn dir_from_uv(&self, uv: [f32; 2]) -> (Vec3, f32) {
+        let phi = uv[0] * 2.0 * PI;
+        let theta = uv[1] * PI;
+        let (st, ct) = theta.sin_cos();
+        let d = Vec3 { x: st * phi.sin(), y: ct, z: -st * phi.cos() };
+        (self.to_world.vector(d).normalize(), st)
+    }
+
+    fn lookup(&self, uv: [f32; 2]) -> Rgb {
+        let x = ((uv[0] * self.image.width as f32) as usize).min(self.image.width - 1);
+        let y = ((uv[1] * self.image.height as f32) as usize).min(self.image.height - 1);
+        self.image.pixels[y * self.image.width + x] * self.scale
+    }
+
+    pub fn eval(&self, dir: Vec3) -> Rgb {
+        self.lookup(self.uv_from_dir(dir))
+    }
+
+    pub fn pdf(&self, dir: Vec3) -> f32 {
+        let uv = self.uv_from_dir(dir);
+        let (w, h) = (self.image.width, self.image.height);
+        let x = ((uv[0] * w as f32) as usize).min(w - 1);
+        let y = ((uv[1] * h as f32) as usize).min(h - 1);
+        let sin_t = (uv[1] * PI).sin();
+        if sin_t <= 0.0 {
+            return 0.0;
+        }
+        let pmf = self.rows.pmf(y) * self.cols[y].pmf(x);
+        // Pixel density in uv is pmf * w * h; Jacobian uv -> solid angle is 2π² sin θ.
+        pmf * (w * h) as f32 / (2.0 * PI * PI * sin_t)
+    }
+
+    pub fn sample(&self, u: [f32; 2]) -> Option<LightSample> {
+        let (w, h) = (self.image.width, self.image.height);
+        let row = self.rows.sample(u[1]);
+        let col = self.cols[row.index].sample(u[0]);
+        let uv = [(col.index as f32 + col.remapped) / w as f32, (row.index as f32 + row.remapped) / h as f32];
+        let (wi, sin_t) = self.dir_from_uv(uv);
+        if sin_t <= 0.0 {
+            return None;
+        }
+        let pdf = row.pmf * col.pmf * (w * h) as f32 / (2.0 * PI * PI * sin_t);
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(LightSample { wi, radiance: self.lookup(uv), pdf, dist: f32::INFINITY, delta: false })
+    }
+}

@@ -1,0 +1,309 @@
+//! Light sources. Every light answers the same questions:
+//! - `sample_li(ref_p, u)`: a direction towards the light from a reference point, the
+//!   radiance arriving along it, its solid-angle density, and the distance for the shadow ray;
+//! - `pdf_li(...)`: that density for a direction found another way (a BSDF sample that hit
+//!   the light), so that multiple importance sampling can weigh the two;
+//! - `power()`: an estimate of emitted flux, for choosing among lights.
+//!
+//! Delta lights (point, spot, directional) have a density of 1 by convention and are never
+//! hit by BSDF-sampled rays.
+
+mod envmap;
+pub use envmap::EnvMap;
+
+use crate::geometry::Sphere;
+use crate::math::{Aabb, Frame, Rgb, Vec3, PI};
+use crate::sampling::{warp, Distribution1d};
+use std::sync::Arc;
+
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the reference point towards the light.
+    pub wi: Vec3,
+    /// Radiance arriving at the reference point along `wi` (for delta lights: intensity / d²).
+    pub radiance: Rgb,
+    /// Solid-angle density of `wi` (1 for delta lights).
+    pub pdf: f32,
+    /// Distance to the light sample (infinity for infinite lights).
+    pub dist: f32,
+    pub delta: bool,
+}
+
+/// A triangle-mesh emitter, with its triangles in world space and a distribution
+/// proportional to their area (the paper's choice: pick a triangle by area, then a uniform
+/// point on it).
+#[derive(Clone, Debug)]
+pub struct MeshEmitter {
+    pub triangles: Vec<[Vec3; 3]>,
+    pub areas: Distribution1d,
+    pub total_area: f32,
+}
+
+#[derive(Clone, Debug)]
+pub enum Light {
+    Point {
+        position: Vec3,
+        intensity: Rgb,
+    },
+    /// Cone light; falloff is linear in angle between `cos_beam` and `cos_cutoff` (Mitsuba's).
+    Spot {
+        position: Vec3,
+        frame: Frame,
+        intensity: Rgb,
+        cutoff: f32,
+        beam: f32,
+    },
+    /// Light from direction `-direction` (i.e. travelling along `direction`) with irradiance
+    /// `irradiance` on a perpendicular surface.
+    Directional {
+        direction: Vec3,
+        irradiance: Rgb,
+        scene_radius: f32,
+    },
+    /// Area light on a triangle mesh instance.
+    Mesh {
+        instance: u32,
+        emitter: Arc<MeshEmitter>,
+        radiance: Rgb,
+        two_sided: bool,
+    },
+    /// Area light on a sphere; sampled by the solid angle it subtends.
+    Sphere {
+        instance: u32,
+        sphere: Sphere,
+        radiance: Rgb,
+    },
+    /// Uniform radiance from every direction.
+    Constant {
+        radiance: Rgb,
+        scene_radius: f32,
+    },
+    /// Environment map, importance-sampled by luminance.
+    EnvMap(Arc<EnvMap>),
+}
+
+impl Light {
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. })
+    }
+
+    pub fn is_infinite(&self) -> bool {
+        matches!(self, Light::Directional { .. } | Light::Constant { .. } | Light::EnvMap(_))
+    }
+
+    /// Surface area of an area light (0 for the others).
+    pub fn area(&self) -> f32 {
+        match self {
+            Light::Mesh { emitter, .. } => emitter.total_area,
+            Light::Sphere { sphere, .. } => sphere.area(),
+            _ => 0.0,
+        }
+    }
+
+    /// Emitted flux (luminance-weighted) for power-proportional light selection.
+    pub fn power(&self) -> f32 {
+        match self {
+            Light::Point { intensity, .. } => 4.0 * PI * intensity.luminance(),
+            Light::Spot { intensity, cutoff, beam, .. } => {
+                // Solid angle of the cone, counting the falloff band at half weight.
+                let mid = 0.5 * (cutoff + beam);
+                2.0 * PI * (1.0 - mid.cos()) * intensity.luminance()
+            }
+            Light::Directional { irradiance, scene_radius, .. } => {
+                PI * scene_radius * scene_radius * irradiance.luminance()
+            }
+            Light::Mesh { emitter, radiance, two_sided, .. } => {
+                let sides = if *two_sided { 2.0 } else { 1.0 };
+                sides * PI * emitter.total_area * radiance.luminance()
+            }
+            Light::Sphere { sphere, radiance, .. } => PI * sphere.area() * radiance.luminance(),
+            Light::Constant { radiance, scene_radius } => {
+                4.0 * PI * PI * scene_radius * scene_radius * radiance.luminance()
+            }
+            Light::EnvMap(env) => 4.0 * PI * PI * env.scene_radius * env.scene_radius * env.mean_luminance(),
+        }
+    }
+
+    /// Samples a direction towards the light as seen from `p`. `None` when the light sends
+    /// nothing towards `p` for this sample.
+    pub fn sample_li(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        match self {
+            Light::Point { position, intensity } => {
+                let d = *position - p;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                Some(LightSample { wi: d / dist, radiance: *intensity / dist2, pdf: 1.0, dist, delta: true })
+            }
+            Light::Spot { position, frame, intensity, cutoff, beam } => {
+                let d = *position - p;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos_t = frame.to_local(-wi).z;
+                let falloff = spot_falloff(cos_t, *cutoff, *beam);
+                if falloff <= 0.0 {
+                    return None;
+                }
+                Some(LightSample { wi, radiance: *intensity * (falloff / dist2), pdf: 1.0, dist, delta: true })
+            }
+            Light::Directional { direction, irradiance, .. } => {
+                Some(LightSample { wi: -*direction, radiance: *irradiance, pdf: 1.0, dist: f32::INFINITY, delta: true })
+            }
+            Light::Mesh { emitter, radiance, two_sided, .. } => {
+                let pick = emitter.areas.sample(u[0]);
+                let [a, b, c] = emitter.triangles[pick.index];
+                let bary = warp::uniform_triangle([pick.remapped, u[1]]);
+                let q = a * (1.0 - bary[0] - bary[1]) + b * bary[0] + c * bary[1];
+                let n = (b - a).cross(c - a).normalize();
+                let d = q - p;
+                let dist2 = d.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos_l = -n.dot(wi);
+                if cos_l == 0.0 || (!two_sided && cos_l < 0.0) {
+                    return None;
+                }
+                let pdf = dist2 / (cos_l.abs() * emitter.total_area);
+                Some(LightSample { wi, radiance: *radiance, pdf, dist, delta: false })
+            }
+            Light::Sphere { sphere, radiance, .. } => sample_sphere(sphere, *radiance, p, u),
+            Light::Constant { radiance, .. } => {
+                let wi = warp::uniform_sphere(u);
+                Some(LightSample {
+                    wi,
+                    radiance: *radiance,
+                    pdf: warp::UNIFORM_SPHERE_PDF,
+                    dist: f32::INFINITY,
+                    delta: false,
+                })
+            }
+            Light::EnvMap(env) => env.sample(u),
+        }
+    }
+
+    /// Solid-angle density of `sample_li` from `p` producing the point `q` (normal `n`) on an
+    /// area light, or direction `wi` for an infinite light.
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3, q: Vec3, n: Vec3) -> f32 {
+        match self {
+            Light::Mesh { emitter, .. } => {
+                let dist2 = (q - p).length_squared();
+                let cos_l = n.dot(wi).abs();
+                if cos_l == 0.0 {
+                    return 0.0;
+                }
+                dist2 / (cos_l * emitter.total_area)
+            }
+            Light::Sphere { sphere, .. } => pdf_sphere(sphere, p, q, n, wi),
+            Light::Constant { .. } => warp::UNIFORM_SPHERE_PDF,
+            Light::EnvMap(env) => env.pdf(wi),
+            _ => 0.0,
+        }
+    }
+
+    /// Radiance leaving an area light at a point with geometric normal `n` towards `-wi`
+    /// (`wi` is the direction the ray travelled).
+    pub fn emitted(&self, n: Vec3, wi: Vec3) -> Rgb {
+        match self {
+            Light::Mesh { radiance, two_sided, .. } => {
+                if *two_sided || n.dot(wi) < 0.0 {
+                    *radiance
+                } else {
+                    Rgb::BLACK
+                }
+            }
+            Light::Sphere { radiance, .. } => {
+                if n.dot(wi) < 0.0 {
+                    *radiance
+                } else {
+                    Rgb::BLACK
+                }
+            }
+            _ => Rgb::BLACK,
+        }
+    }
+
+    /// Radiance from an infinite light arriving along a ray that escaped with direction `dir`.
+    pub fn environment(&self, dir: Vec3) -> Rgb {
+        match self {
+            Light::Constant { radiance, .. } => *radiance,
+            Light::EnvMap(env) => env.eval(dir),
+            _ => Rgb::BLACK,
+        }
+    }
+}
+
+fn spot_falloff(cos_t: f32, cutoff: f32, beam: f32) -> f32 {
+    if cos_t <= cutoff.cos() {
+        return 0.0;
+    }
+    if cos_t >= beam.cos() {
+        return 1.0;
+    }
+    ((cutoff - cos_t.clamp(-1.0, 1.0).acos()) / (cutoff - beam)).clamp(0.0, 1.0)
+}
+
+/// Cone sampling of a sphere seen from outside (pbrt's approach), uniform area from inside.
+fn sample_sphere(s: &Sphere, radiance: Rgb, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+    let to_c = s.center - p;
+    let dc2 = to_c.length_squared();
+    let r2 = s.radius * s.radius;
+    if dc2 <= r2 * 1.0001 {
+        // Inside (or on) the sphere: sample its area uniformly.
+        let n = warp::uniform_sphere(u);
+        let q = s.center + n * s.radius;
+        let d = q - p;
+        let dist2 = d.length_squared();
+        if dist2 == 0.0 {
+            return None;
+        }
+        let dist = dist2.sqrt();
+        let wi = d / dist;
+        let cos_l = n.dot(wi).abs();
+        if cos_l == 0.0 {
+            return None;
+        }
+        // From inside, the outward-facing sphere emits nothing towards p.
+        if n.dot(wi) < 0.0 {
+            return None;
+        }
+        return Some(LightSample { wi, radiance, pdf: dist2 / (cos_l * s.area()), dist, delta: false });
+    }
+    let dc = dc2.sqrt();
+    let sin_max2 = r2 / dc2;
+    let cos_max = (1.0 - sin_max2).max(0.0).sqrt();
+    let frame = Frame::from_normal(to_c / dc);
+    let local = warp::uniform_cone(u, cos_max);
+    let wi = frame.to_world(local).normalize();
+    // Distance to the near intersection along wi.
+    let b = to_c.dot(wi);
+    let disc = (r2 - (dc2 - b * b)).max(0.0);
+    let dist = b - disc.sqrt();
+    Some(LightSample { wi, radiance, pdf: warp::uniform_cone_pdf(cos_max), dist, delta: false })
+}
+
+fn pdf_sphere(s: &Sphere, p: Vec3, q: Vec3, n: Vec3, wi: Vec3) -> f32 {
+    let dc2 = (s.center - p).length_squared();
+    let r2 = s.radius * s.radius;
+    if dc2 <= r2 * 1.0001 {
+        let dist2 = (q - p).length_squared();
+        let cos_l = n.dot(wi).abs();
+        if cos_l == 0.0 {
+            return 0.0;
+        }
+        return dist2 / (cos_l * s.area());
+    }
+    let cos_max = (1.0 - r2 / dc2).max(0.0).sqrt();
+    warp::uniform_cone_pdf(cos_max)
+}
+
+/// Radius of a sphere that bounds the scene, for infinite lights' power estimates.
+pub fn scene_radius(bounds: &Aabb) -> f32 {
+    if bounds.is_empty() {
+        1.0
+    } else {
+        (bounds.extent().length() * 0.5).max(1e-3)
+    }
+}

@@ -1,0 +1,319 @@
+//! The one path from any scene description (native JSON, Mitsuba XML) to the render-ready
+//! [`Scene`]: loaders call these methods, which validate, load meshes once, fold transforms
+//! and create area lights.
+
+use super::world::{Instance, LightSelection, Scene, ShapeRef};
+use crate::accel::BvhSplit;
+use crate::camera::Camera;
+use crate::geometry::{Sphere, TriangleMesh};
+use crate::io::{obj, ply};
+use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
+use crate::materials::{Bitmap, Material, MaterialKind, Texture};
+use crate::math::{Aabb, Rgb, Transform, Vec3};
+use crate::sampling::Distribution1d;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// An area emitter attached to a shape.
+#[derive(Clone, Copy, Debug)]
+pub struct Emission {
+    pub radiance: Rgb,
+    pub two_sided: bool,
+}
+
+/// Lights that need the finished scene's bounds, created in `finish`.
+enum PendingLight {
+    Ready(Light),
+    Directional { direction: Vec3, irradiance: Rgb },
+    Constant { radiance: Rgb },
+    EnvMap { image: Bitmap, scale: f32, to_world: Transform },
+}
+
+/// A mesh loaded from a file: one per material group.
+#[derive(Clone, Debug)]
+pub struct LoadedGroup {
+    pub mesh: Arc<TriangleMesh>,
+    /// `usemtl` name for OBJ groups, empty otherwise.
+    pub material: String,
+}
+
+pub struct SceneBuilder {
+    pub split: BvhSplit,
+    meshes: Vec<Arc<TriangleMesh>>,
+    spheres: Vec<Sphere>,
+    instances: Vec<Instance>,
+    materials: Vec<Material>,
+    material_names: HashMap<String, u32>,
+    lights: Vec<PendingLight>,
+    file_cache: HashMap<PathBuf, Vec<LoadedGroup>>,
+    mesh_ids: HashMap<*const TriangleMesh, u32>,
+    pub mtl_materials: HashMap<String, obj::MtlMaterial>,
+    pub build_seconds: f64,
+}
+
+impl SceneBuilder {
+    pub fn new(split: BvhSplit) -> SceneBuilder {
+        SceneBuilder {
+            split,
+            meshes: Vec::new(),
+            spheres: Vec::new(),
+            instances: Vec::new(),
+            materials: Vec::new(),
+            material_names: HashMap::new(),
+            lights: Vec::new(),
+            file_cache: HashMap::new(),
+            mesh_ids: HashMap::new(),
+            mtl_materials: HashMap::new(),
+            build_seconds: 0.0,
+        }
+    }
+
+    pub fn add_material(&mut self, m: Material) -> u32 {
+        let id = self.materials.len() as u32;
+        self.material_names.insert(m.name.clone(), id);
+        self.materials.push(m);
+        id
+    }
+
+    pub fn material_id(&self, name: &str) -> Option<u32> {
+        self.material_names.get(name).copied()
+    }
+
+    /// A black, one-sided material for emitters declared without one.
+    pub fn black_material(&mut self) -> u32 {
+        if let Some(id) = self.material_id("__black") {
+            return id;
+        }
+        self.add_material(Material::new("__black", MaterialKind::Black, false))
+    }
+
+    /// A default diffuse material (Mitsuba's: reflectance 0.5), for shapes without one.
+    pub fn default_material(&mut self) -> u32 {
+        if let Some(id) = self.material_id("__default") {
+            return id;
+        }
+        self.add_material(Material::new(
+            "__default",
+            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },
+            false,
+        ))
+    }
+
+    /// Loads an OBJ or PLY file (once per path), transformed by `to_world` baked into the
+    /// vertices unless `instanced` (then the mesh stays in object space for sharing).
+    pub fn load_mesh_file(&mut self, path: &Path, face_normals: bool) -> Result<Vec<LoadedGroup>, String> {
+        if let Some(g) = self.file_cache.get(path) {
+            return Ok(g.clone());
+        }
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+        let start = Instant::now();
+        let groups = match ext.as_str() {
+            "obj" => {
+                let f = obj::read_obj(path)?;
+                for m in f.materials {
+                    self.mtl_materials.insert(m.name.clone(), m);
+                }
+                let mut out = Vec::new();
+                for g in f.groups {
+                    let normals = if face_normals { None } else { g.normals };
+                    let mesh = TriangleMesh::new(g.positions, normals, g.uvs, g.indices, self.split)
+                        .map_err(|e| format!("{}: {e}", path.display()))?;
+                    out.push(LoadedGroup { mesh: Arc::new(mesh), material: g.material });
+                }
+                out
+            }
+            "ply" => {
+                let m = ply::read_ply(path)?;
+                let normals = if face_normals { None } else { m.normals };
+                let mesh = TriangleMesh::new(m.positions, normals, m.uvs, m.indices, self.split)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                vec![LoadedGroup { mesh: Arc::new(mesh), material: String::new() }]
+            }
+            _ => return Err(format!("{}: unknown mesh format (expected .obj or .ply)", path.display())),
+        };
+        self.build_seconds += start.elapsed().as_secs_f64();
+        self.file_cache.insert(path.to_path_buf(), groups.clone());
+        Ok(groups)
+    }
+
+    fn mesh_id(&mut self, mesh: &Arc<TriangleMesh>) -> u32 {
+        let key = Arc::as_ptr(mesh);
+        if let Some(&id) = self.mesh_ids.get(&key) {
+            return id;
+        }
+        let id = self.meshes.len() as u32;
+        self.meshes.push(mesh.clone());
+        self.mesh_ids.insert(key, id);
+        id
+    }
+
+    /// Places a mesh. With `instanced` the mesh is shared and traced through its transform;
+    /// otherwise the transform is baked into a private copy of the vertices (faster to trace).
+    pub fn add_mesh_instance(
+        &mut self,
+        mesh: &Arc<TriangleMesh>,
+        to_world: &Transform,
+        instanced: bool,
+        material: u32,
+        emission: Option<Emission>,
+        flip_normals: bool,
+    ) -> Result<(), String> {
+        let (mesh, xf) = if instanced || to_world.is_identity() {
+            (mesh.clone(), if to_world.is_identity() { None } else { Some(*to_world) })
+        } else {
+            let start = Instant::now();
+            let positions = mesh.positions.iter().map(|&p| to_world.point(p)).collect();
+            let normals = mesh.normals.as_ref().map(|ns| ns.iter().map(|&n| to_world.normal(n).normalize()).collect());
+            // Indices are kept: as in Mitsuba, a mirroring transform reverses the winding and
+            // so flips the face normal.
+            let m = TriangleMesh::new(positions, normals, mesh.uvs.clone(), mesh.indices.clone(), self.split)?;
+            self.build_seconds += start.elapsed().as_secs_f64();
+            (Arc::new(m), None)
+        };
+        let id = self.mesh_id(&mesh);
+        let bounds = match &xf {
+            None => mesh.bounds(),
+            Some(t) => t.aabb(&mesh.bounds()),
+        };
+        let instance = self.instances.len() as u32;
+        let light = emission.map(|e| {
+            let triangles: Vec<[Vec3; 3]> = (0..mesh.indices.len())
+                .map(|t| {
+                    let v = mesh.vertices(t);
+                    match &xf {
+                        None => v,
+                        Some(x) => [x.point(v[0]), x.point(v[1]), x.point(v[2])],
+                    }
+                })
+                .map(|[a, b, c]| if flip_normals { [a, c, b] } else { [a, b, c] })
+                .collect();
+            let areas: Vec<f32> = triangles.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
+            let total_area = areas.iter().sum();
+            (triangles, areas, total_area, e)
+        });
+        let light = match light {
+            Some((triangles, areas, total_area, e)) => {
+                let Some(dist) = Distribution1d::new(&areas) else {
+                    return Err("an emitting mesh has zero area".into());
+                };
+                let emitter = Arc::new(MeshEmitter { triangles, areas: dist, total_area });
+                self.lights.push(PendingLight::Ready(Light::Mesh {
+                    instance,
+                    emitter,
+                    radiance: e.radiance,
+                    two_sided: e.two_sided,
+                }));
+                Some(self.lights.len() as u32 - 1)
+            }
+            None => None,
+        };
+        self.instances.push(Instance {
+            shape: ShapeRef::Mesh(id),
+            to_world: xf,
+            material,
+            light,
+            flip_normals,
+            bounds,
+        });
+        Ok(())
+    }
+
+    /// Places a sphere; its transform must be a similarity (uniform scale).
+    pub fn add_sphere(
+        &mut self,
+        center: Vec3,
+        radius: f32,
+        to_world: &Transform,
+        material: u32,
+        emission: Option<Emission>,
+        flip_normals: bool,
+    ) -> Result<(), String> {
+        let c = to_world.point(center);
+        let axes = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| to_world.vector(a).length());
+        if (axes[0] - axes[1]).abs() > 1e-4 * axes[0] || (axes[0] - axes[2]).abs() > 1e-4 * axes[0] {
+            return Err("a sphere's transform must scale all axes equally".into());
+        }
+        let r = radius * axes[0];
+        if !(r > 0.0 && r.is_finite()) {
+            return Err(format!("sphere radius must be positive, got {r}"));
+        }
+        let sphere = Sphere { center: c, radius: r };
+        let id = self.spheres.len() as u32;
+        self.spheres.push(sphere);
+        let instance = self.instances.len() as u32;
+        let light = emission.map(|e| {
+            self.lights.push(PendingLight::Ready(Light::Sphere { instance, sphere, radiance: e.radiance }));
+            self.lights.len() as u32 - 1
+        });
+        self.instances.push(Instance {
+            shape: ShapeRef::Sphere(id),
+            to_world: None,
+            material,
+            light,
+            flip_normals,
+            bounds: sphere.bounds(),
+        });
+        Ok(())
+    }
+
+    pub fn add_light(&mut self, light: Light) {
+        self.lights.push(PendingLight::Ready(light));
+    }
+    pub fn add_directional(&mut self, direction: Vec3, irradiance: Rgb) {
+        self.lights.push(PendingLight::Directional { direction: direction.normalize(), irradiance });
+    }
+    pub fn add_constant_environment(&mut self, radiance: Rgb) {
+        self.lights.push(PendingLight::Constant { radiance });
+    }
+    pub fn add_envmap(&mut self, image: Bitmap, scale: f32, to_world: Transform) {
+        self.lights.push(PendingLight::EnvMap { image, scale, to_world });
+    }
+
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
+    }
+
+    pub fn finish(self, camera: Camera, selection: LightSelection) -> Result<Scene, String> {
+        let start = Instant::now();
+        let bounds = self.instances.iter().fold(Aabb::EMPTY, |a, i| a.union(i.bounds));
+        let radius = scene_radius(&bounds);
+        let mut lights = Vec::new();
+        let mut environment_lights = Vec::new();
+        for l in self.lights {
+            let light = match l {
+                PendingLight::Ready(l) => l,
+                PendingLight::Directional { direction, irradiance } => {
+                    Light::Directional { direction, irradiance, scene_radius: radius }
+                }
+                PendingLight::Constant { radiance } => Light::Constant { radiance, scene_radius: radius },
+                PendingLight::EnvMap { image, scale, to_world } => {
+                    Light::EnvMap(Arc::new(EnvMap::new(image, scale, to_world, radius)?))
+                }
+            };
+            if matches!(light, Light::Constant { .. } | Light::EnvMap(_)) {
+                environment_lights.push(lights.len() as u32);
+            }
+            lights.push(light);
+        }
+        let mut scene = Scene {
+            meshes: self.meshes,
+            spheres: self.spheres,
+            instances: self.instances,
+            top: Default::default(),
+            materials: self.materials,
+            lights,
+            environment_lights,
+            camera,
+            bounds,
+            light_distribution: None,
+            light_selection: selection,
+            bvh_split: self.split,
+            bvh_build_seconds: 0.0,
+        };
+        scene.finish(selection);
+        scene.bvh_build_seconds = self.build_seconds + start.elapsed().as_secs_f64();
+        Ok(scene)
+    }
+}

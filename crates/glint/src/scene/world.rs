@@ -1,0 +1,305 @@
+//! The render-ready scene: geometry in a two-level BVH, materials, lights and the camera.
+//!
+//! Bottom level: one BVH per mesh, in the mesh's own space. Top level: a BVH over
+//! instances, each a reference to a shape with its own transform, so a mesh placed many times
+//! costs its memory once. Traversal returns a cheap [`Hit`]; the full
+//! [`SurfaceInteraction`] is computed only for the hit that is shaded.
+
+use crate::accel::{Bvh, BvhSplit};
+use crate::camera::Camera;
+use crate::geometry::{Sphere, TriangleMesh};
+use crate::lights::Light;
+use crate::materials::Material;
+use crate::math::{Aabb, Frame, Ray, Transform, Vec3};
+use crate::sampling::Distribution1d;
+use std::sync::Arc;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShapeRef {
+    Mesh(u32),
+    Sphere(u32),
+}
+
+#[derive(Clone, Debug)]
+pub struct Instance {
+    pub shape: ShapeRef,
+    /// Object to world; `None` for the identity (the common case, traced without transforms).
+    pub to_world: Option<Transform>,
+    pub material: u32,
+    /// Index into `Scene::lights` when the shape emits light.
+    pub light: Option<u32>,
+    pub flip_normals: bool,
+    pub bounds: Aabb,
+}
+
+/// What traversal returns: enough to find the hit again, nothing more.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub instance: u32,
+    pub prim: u32,
+    pub b1: f32,
+    pub b2: f32,
+}
+
+/// Everything shading needs about a hit point.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceInteraction {
+    pub p: Vec3,
+    /// Geometric normal (unit, world), after `flip_normals`; not turned towards the ray.
+    pub ng: Vec3,
+    /// Shading frame (interpolated normal when the mesh has one).
+    pub frame: Frame,
+    pub uv: [f32; 2],
+    pub instance: u32,
+    pub material: u32,
+    pub light: Option<u32>,
+    pub t: f32,
+}
+
+/// How the integrators choose which light to sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LightSelection {
+    Uniform,
+    /// Proportional to area (the paper's choice); non-area lights get the mean weight.
+    Area,
+    /// Proportional to emitted power.
+    #[default]
+    Power,
+}
+
+impl std::str::FromStr for LightSelection {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "uniform" => Ok(LightSelection::Uniform),
+            "area" => Ok(LightSelection::Area),
+            "power" => Ok(LightSelection::Power),
+            _ => Err(format!("unknown light selection '{s}' (expected uniform, area or power)")),
+        }
+    }
+}
+
+pub struct Scene {
+    pub meshes: Vec<Arc<TriangleMesh>>,
+    pub spheres: Vec<Sphere>,
+    pub instances: Vec<Instance>,
+    pub top: Bvh,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    /// Indices of infinite lights that a escaping ray sees (constant, envmap).
+    pub environment_lights: Vec<u32>,
+    pub camera: Camera,
+    pub bounds: Aabb,
+    pub light_distribution: Option<Distribution1d>,
+    pub light_selection: LightSelection,
+    pub bvh_split: BvhSplit,
+    pub bvh_build_seconds: f64,
+}
+
+impl Scene {
+    /// Builds the top-level BVH and the light-selection distribution. Called once by the
+    /// scene builder after all instances and lights are in place.
+    pub fn finish(&mut self, selection: LightSelection) {
+        let boxes: Vec<Aabb> = self.instances.iter().map(|i| i.bounds).collect();
+        self.top = Bvh::build(&boxes, self.bvh_split);
+        self.bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+        self.set_light_selection(selection);
+    }
+
+    pub fn set_light_selection(&mut self, selection: LightSelection) {
+        self.light_selection = selection;
+        let weights: Vec<f32> = match selection {
+            LightSelection::Uniform => vec![1.0; self.lights.len()],
+            LightSelection::Power => self.lights.iter().map(|l| l.power()).collect(),
+            LightSelection::Area => {
+                let areas: Vec<f32> = self.lights.iter().map(|l| l.area()).collect();
+                let n_area = areas.iter().filter(|&&a| a > 0.0).count();
+                let mean = if n_area > 0 { areas.iter().sum::<f32>() / n_area as f32 } else { 1.0 };
+                areas.iter().map(|&a| if a > 0.0 { a } else { mean }).collect()
+            }
+        };
+        self.light_distribution = Distribution1d::new(&weights);
+    }
+
+    /// Probability of choosing light `i` for next-event estimation.
+    #[inline]
+    pub fn light_pmf(&self, i: u32) -> f32 {
+        self.light_distribution.as_ref().map_or(0.0, |d| d.pmf(i as usize))
+    }
+
+    /// Closest hit along the ray within its interval.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let mut r = *ray;
+        let mut best: Option<Hit> = None;
+        self.top.traverse(&mut r, |inst_idx, r| {
+            let inst = &self.instances[inst_idx as usize];
+            if let Some(h) = self.intersect_instance(inst, r) {
+                r.t_max = h.t;
+                best = Some(Hit { instance: inst_idx, ..h });
+                true
+            } else {
+                false
+            }
+        });
+        best
+    }
+
+    #[inline]
+    fn intersect_instance(&self, inst: &Instance, r: &Ray) -> Option<Hit> {
+        match inst.shape {
+            ShapeRef::Mesh(m) => {
+                let mesh = &self.meshes[m as usize];
+                let mut local = match &inst.to_world {
+                    None => *r,
+                    Some(t) => Ray { origin: t.inv_point(r.origin), dir: t.inv_vector(r.dir), ..*r },
+                };
+                mesh.intersect(&mut local).map(|(tri, h)| Hit { t: h.t, instance: 0, prim: tri, b1: h.b1, b2: h.b2 })
+            }
+            ShapeRef::Sphere(s) => {
+                self.spheres[s as usize].intersect(r).map(|t| Hit { t, instance: 0, prim: 0, b1: 0.0, b2: 0.0 })
+            }
+        }
+    }
+
+    /// True when anything blocks the ray within its interval.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.top.occluded(ray, |inst_idx, r| {
+            let inst = &self.instances[inst_idx as usize];
+            match inst.shape {
+                ShapeRef::Mesh(m) => {
+                    let mesh = &self.meshes[m as usize];
+                    match &inst.to_world {
+                        None => mesh.occluded(r),
+                        Some(t) => {
+                            mesh.occluded(&Ray { origin: t.inv_point(r.origin), dir: t.inv_vector(r.dir), ..*r })
+                        }
+                    }
+                }
+                ShapeRef::Sphere(s) => self.spheres[s as usize].intersect(r).is_some(),
+            }
+        })
+    }
+
+    /// Every primitive of every instance, for testing the BVH against brute force.
+    pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
+        let mut r = *ray;
+        let mut best = None;
+        for (i, inst) in self.instances.iter().enumerate() {
+            let h = match inst.shape {
+                ShapeRef::Mesh(m) => {
+                    let local = match &inst.to_world {
+                        None => r,
+                        Some(t) => Ray { origin: t.inv_point(r.origin), dir: t.inv_vector(r.dir), ..r },
+                    };
+                    self.meshes[m as usize].intersect_brute_force(&local).map(|(tri, h)| Hit {
+                        t: h.t,
+                        instance: i as u32,
+                        prim: tri,
+                        b1: h.b1,
+                        b2: h.b2,
+                    })
+                }
+                ShapeRef::Sphere(s) => self.spheres[s as usize].intersect(&r).map(|t| Hit {
+                    t,
+                    instance: i as u32,
+                    prim: 0,
+                    b1: 0.0,
+                    b2: 0.0,
+                }),
+            };
+            if let Some(h) = h {
+                r.t_max = h.t;
+                best = Some(h);
+            }
+        }
+        best
+    }
+
+    /// The full surface interaction for a hit found along `ray`.
+    pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
+        let inst = &self.instances[hit.instance as usize];
+        let (p, mut ng, mut ns, uv) = match inst.shape {
+            ShapeRef::Mesh(m) => {
+                let mesh = &self.meshes[m as usize];
+                let tri = hit.prim as usize;
+                let [i0, i1, i2] = mesh.indices[tri];
+                let [a, b, c] = mesh.vertices(tri);
+                let b0 = 1.0 - hit.b1 - hit.b2;
+                let p_obj = a * b0 + b * hit.b1 + c * hit.b2;
+                let ng_obj = (b - a).cross(c - a);
+                let ns_obj = mesh
+                    .normals
+                    .as_ref()
+                    .map(|n| n[i0 as usize] * b0 + n[i1 as usize] * hit.b1 + n[i2 as usize] * hit.b2);
+                let uv = mesh.uvs.as_ref().map_or([hit.b1, hit.b2], |t| {
+                    let (t0, t1, t2) = (t[i0 as usize], t[i1 as usize], t[i2 as usize]);
+                    [t0[0] * b0 + t1[0] * hit.b1 + t2[0] * hit.b2, t0[1] * b0 + t1[1] * hit.b1 + t2[1] * hit.b2]
+                });
+                match &inst.to_world {
+                    None => (p_obj, ng_obj, ns_obj, uv),
+                    Some(t) => {
+                        // Orientation follows the winding in world space, as when vertices
+                        // are transformed: a mirroring transform flips the normal.
+                        let flip = if t.swaps_handedness() { -1.0 } else { 1.0 };
+                        (t.point(p_obj), t.normal(ng_obj) * flip, ns_obj.map(|n| t.normal(n)), uv)
+                    }
+                }
+            }
+            ShapeRef::Sphere(s) => {
+                let sph = &self.spheres[s as usize];
+                let mut p = ray.at(hit.t);
+                let n = (p - sph.center) / sph.radius;
+                // Re-project onto the surface to remove the error of the root.
+                p = sph.center + n * sph.radius;
+                let local = n;
+                let theta = local.z.clamp(-1.0, 1.0).acos();
+                let mut phi = local.y.atan2(local.x);
+                if phi < 0.0 {
+                    phi += 2.0 * std::f32::consts::PI;
+                }
+                (p, n, None, [phi / (2.0 * std::f32::consts::PI), theta / std::f32::consts::PI])
+            }
+        };
+        ng = ng.normalize();
+        if inst.flip_normals {
+            ng = -ng;
+        }
+        let mut n_shading = match ns.take() {
+            Some(n) if n.length_squared() > 0.0 => {
+                let n = n.normalize();
+                if inst.flip_normals {
+                    -n
+                } else {
+                    n
+                }
+            }
+            _ => ng,
+        };
+        if !n_shading.is_finite() {
+            n_shading = ng;
+        }
+        SurfaceInteraction {
+            p,
+            ng,
+            frame: Frame::from_normal(n_shading),
+            uv,
+            instance: hit.instance,
+            material: inst.material,
+            light: inst.light,
+            t: hit.t,
+        }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .map(|i| match i.shape {
+                ShapeRef::Mesh(m) => self.meshes[m as usize].indices.len(),
+                ShapeRef::Sphere(_) => 0,
+            })
+            .sum()
+    }
+}
