@@ -69,13 +69,9 @@ pub fn intersect_triangle(ray: &Ray, sh: &ShearedRay, p0: Vec3, p1: Vec3, p2: Ve
     let bz = sh.sz * b[kz];
     let cz = sh.sz * c[kz];
     let t_scaled = u * az + v * bz + w * cz;
-    // Compare t against the interval without dividing: t = t_scaled / det.
-    let det_sign = if det < 0.0 { -1.0f32 } else { 1.0 };
-    let ts = t_scaled * det_sign;
-    let adet = det.abs();
-    if ts <= ray.t_min * adet || ts >= ray.t_max * adet {
-        return None;
-    }
+    // Divide before comparing with the interval: a comparison in the scaled space rounds
+    // differently from `t` itself, which would make the closest hit depend on the order in
+    // which triangles that meet the ray at (nearly) the same distance are tested.
     let inv = 1.0 / det;
     let t = t_scaled * inv;
     if !(t > ray.t_min && t < ray.t_max) {
