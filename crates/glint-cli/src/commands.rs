@@ -140,7 +140,7 @@ fn render_cmd(a: RenderArgs) -> Result<(), String> {
     if !a.quiet {
         let s = &out.stats;
         eprintln!(
-            "glint: {} {}x{} @ {} spp ({}) in {:.2} s (load {:.2} s): {:.1} M rays ({:.2} Mrays/s), {} discarded samples -> {}",
+            "glint: {} {}x{} @ {} spp ({}) in {:.3} s (load {:.3} s): {:.1} M rays ({:.2} Mrays/s), {} discarded samples -> {}",
             a.scene.scene.display(),
             scene.camera.width,
             scene.camera.height,

@@ -108,7 +108,7 @@ impl SceneBuilder {
             return Ok(g.clone());
         }
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-        let start = Instant::now();
+        let mut build = 0.0;
         let groups = match ext.as_str() {
             "obj" => {
                 let f = obj::read_obj(path)?;
@@ -118,8 +118,10 @@ impl SceneBuilder {
                 let mut out = Vec::new();
                 for g in f.groups {
                     let normals = if face_normals { None } else { g.normals };
+                    let start = Instant::now();
                     let mesh = TriangleMesh::new(g.positions, normals, g.uvs, g.indices, self.split)
                         .map_err(|e| format!("{}: {e}", path.display()))?;
+                    build += start.elapsed().as_secs_f64();
                     out.push(LoadedGroup { mesh: Arc::new(mesh), material: g.material });
                 }
                 out
@@ -127,13 +129,15 @@ impl SceneBuilder {
             "ply" => {
                 let m = ply::read_ply(path)?;
                 let normals = if face_normals { None } else { m.normals };
+                let start = Instant::now();
                 let mesh = TriangleMesh::new(m.positions, normals, m.uvs, m.indices, self.split)
                     .map_err(|e| format!("{}: {e}", path.display()))?;
+                build += start.elapsed().as_secs_f64();
                 vec![LoadedGroup { mesh: Arc::new(mesh), material: String::new() }]
             }
             _ => return Err(format!("{}: unknown mesh format (expected .obj or .ply)", path.display())),
         };
-        self.build_seconds += start.elapsed().as_secs_f64();
+        self.build_seconds += build;
         self.file_cache.insert(path.to_path_buf(), groups.clone());
         Ok(groups)
     }
