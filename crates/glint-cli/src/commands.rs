@@ -4,6 +4,7 @@ use clap::{Args, Parser, Subcommand};
 use glint::accel::BvhSplit;
 use glint::integrators::{Integrator, PathSettings, Strategy, WhittedSettings};
 use glint::render::{render, Progress, RenderSettings, Silent};
+use glint::sampling::SamplerKind;
 use glint::scene::{load, LightSelection, LoadOptions, LoadedScene, ShapeRef};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -65,6 +66,9 @@ struct RenderArgs {
     /// Image height (overrides the scene's film).
     #[arg(long)]
     height: Option<u32>,
+    /// Sampler: sobol (Owen-scrambled, the default) or independent.
+    #[arg(long)]
+    sampler: Option<SamplerKind>,
     /// Random seed.
     #[arg(long)]
     seed: Option<u64>,
@@ -125,6 +129,7 @@ fn render_cmd(a: RenderArgs) -> Result<(), String> {
     let settings = RenderSettings {
         spp: a.spp.unwrap_or(loaded.settings.spp),
         seed: a.seed.unwrap_or(loaded.settings.seed),
+        sampler: a.sampler.unwrap_or(loaded.settings.sampler),
         ..loaded.settings
     };
     if settings.spp == 0 {

@@ -11,7 +11,7 @@ pub use whitted::WhittedSettings;
 
 use crate::bsdf::Bsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
-use crate::sampling::Rng;
+use crate::sampling::Sampler;
 use crate::scene::{Scene, SurfaceInteraction};
 
 /// Per-thread counters, summed at the end of a render.
@@ -36,7 +36,7 @@ impl Integrator {
     }
 
     #[inline]
-    pub fn li(&self, scene: &Scene, ray: &Ray, rng: &mut Rng, counters: &mut Counters) -> Rgb {
+    pub fn li(&self, scene: &Scene, ray: &Ray, rng: &mut Sampler, counters: &mut Counters) -> Rgb {
         match self {
             Integrator::Whitted(s) => whitted::li(s, scene, ray, rng, counters),
             Integrator::Path(s) => path::li(s, scene, ray, rng, counters),

@@ -5,7 +5,7 @@
 
 use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::math::{Ray, Rgb};
-use crate::sampling::{power_heuristic, Rng};
+use crate::sampling::{power_heuristic, Sampler};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 
@@ -60,7 +60,7 @@ impl Default for PathSettings {
     }
 }
 
-pub fn li(s: &PathSettings, scene: &Scene, camera_ray: &Ray, rng: &mut Rng, c: &mut Counters) -> Rgb {
+pub fn li(s: &PathSettings, scene: &Scene, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
     let max_depth = s.max_depth.unwrap_or(u32::MAX);
     if max_depth == 0 {
         return Rgb::BLACK;

@@ -6,7 +6,7 @@
 use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, Bsdf};
 use crate::math::{Ray, Rgb};
-use crate::sampling::Rng;
+use crate::sampling::Sampler;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 
@@ -24,11 +24,11 @@ impl Default for WhittedSettings {
     }
 }
 
-pub fn li(s: &WhittedSettings, scene: &Scene, ray: &Ray, rng: &mut Rng, c: &mut Counters) -> Rgb {
+pub fn li(s: &WhittedSettings, scene: &Scene, ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
     trace(s, scene, ray, rng, c, 1)
 }
 
-fn trace(s: &WhittedSettings, scene: &Scene, ray: &Ray, rng: &mut Rng, c: &mut Counters, depth: u32) -> Rgb {
+fn trace(s: &WhittedSettings, scene: &Scene, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Rgb {
     c.rays += 1;
     let Some(hit) = scene.intersect(ray) else {
         if scene.environment_lights.is_empty() {

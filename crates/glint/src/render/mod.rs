@@ -9,7 +9,7 @@ pub use filter::PixelFilter;
 use crate::integrators::{Counters, Integrator};
 use crate::io::Image;
 use crate::math::Rgb;
-use crate::sampling::Rng;
+use crate::sampling::{Sampler, SamplerKind};
 use crate::scene::Scene;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -20,6 +20,7 @@ pub struct RenderSettings {
     pub spp: u32,
     pub seed: u64,
     pub filter: PixelFilter,
+    pub sampler: SamplerKind,
     /// Also return the per-pixel variance of the mean (for statistical tests).
     pub variance: bool,
     pub tile_size: usize,
@@ -27,7 +28,14 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { spp: 16, seed: 0, filter: PixelFilter::Box, variance: false, tile_size: 16 }
+        RenderSettings {
+            spp: 16,
+            seed: 0,
+            filter: PixelFilter::Box,
+            sampler: SamplerKind::Sobol,
+            variance: false,
+            tile_size: 16,
+        }
     }
 }
 
@@ -108,7 +116,7 @@ pub fn render(
                     let mut sum = [0.0f64; 3];
                     let mut sum2 = [0.0f64; 3];
                     for s in 0..spp {
-                        let mut rng = Rng::for_key(settings.seed, pixel, s as u64);
+                        let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
                         let off = settings.filter.sample(rng.next_2d());
                         let lens = rng.next_2d();
                         let ray = scene.camera.generate_ray(x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1], lens);

@@ -2,10 +2,12 @@
 
 mod distribution;
 mod rng;
+mod sampler;
 pub mod warp;
 
 pub use distribution::{DiscreteSample, Distribution1d};
 pub use rng::{mix64, Rng};
+pub use sampler::{Sampler, SamplerKind};
 
 /// Power heuristic with beta = 2 (Veach 1997), for multiple importance sampling.
 #[inline]

@@ -13,6 +13,7 @@ use crate::lights::Light;
 use crate::materials::{conductor_preset, Bitmap, Material, MaterialKind, Texture};
 use crate::math::{Frame, Mat4, Rgb, Transform, Vec3};
 use crate::render::{PixelFilter, RenderSettings};
+use crate::sampling::SamplerKind;
 use crate::scene::LightSelection;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -95,6 +96,8 @@ enum JsonIntegrator {
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct JsonSampler {
+    #[serde(default, rename = "type")]
+    kind: Option<String>,
     #[serde(default)]
     spp: Option<u32>,
     #[serde(default)]
@@ -626,6 +629,10 @@ pub fn load(path: &Path, text: &str, opts: &LoadOptions) -> Result<LoadedScene, 
         spp: desc.sampler.spp.unwrap_or(16),
         seed: desc.sampler.seed.unwrap_or(0),
         filter,
+        sampler: match desc.sampler.kind.as_deref() {
+            None => SamplerKind::default(),
+            Some(k) => k.parse().map_err(|e| ctx.err(k, e))?,
+        },
         ..Default::default()
     };
     let scene = b.finish(camera, selection).map_err(|e| format!("{}: {e}", path.display()))?;
