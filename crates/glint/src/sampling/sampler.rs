@@ -97,10 +97,11 @@ fn sobol_dim0(i: u32) -> u32 {
 }
 
 /// Second Sobol dimension (primitive polynomial x + 1): direction numbers m_k = 2 m_{k-1} xor
-/// m_{k-1}, i.e. Pascal's triangle mod 2.
+/// m_{k-1}, i.e. Pascal's triangle mod 2. The matrix-vector product over GF(2) is done a
+/// byte at a time with four 256-entry tables built at compile time.
 #[inline]
-fn sobol_dim1(mut i: u32) -> u32 {
-    const V: [u32; 32] = {
+fn sobol_dim1(i: u32) -> u32 {
+    const TABLES: [[u32; 256]; 4] = {
         let mut v = [0u32; 32];
         let mut m: u64 = 1;
         let mut k = 0;
@@ -109,18 +110,30 @@ fn sobol_dim1(mut i: u32) -> u32 {
             m = (m << 1) ^ m;
             k += 1;
         }
-        v
-    };
-    let mut r = 0u32;
-    let mut k = 0;
-    while i != 0 {
-        if i & 1 != 0 {
-            r ^= V[k];
+        let mut t = [[0u32; 256]; 4];
+        let mut byte = 0;
+        while byte < 4 {
+            let mut b = 0;
+            while b < 256 {
+                let mut r = 0u32;
+                let mut bit = 0;
+                while bit < 8 {
+                    if b & (1 << bit) != 0 {
+                        r ^= v[byte * 8 + bit];
+                    }
+                    bit += 1;
+                }
+                t[byte][b] = r;
+                b += 1;
+            }
+            byte += 1;
         }
-        i >>= 1;
-        k += 1;
-    }
-    r
+        t
+    };
+    TABLES[0][(i & 0xff) as usize]
+        ^ TABLES[1][((i >> 8) & 0xff) as usize]
+        ^ TABLES[2][((i >> 16) & 0xff) as usize]
+        ^ TABLES[3][(i >> 24) as usize]
 }
 
 /// Owen scrambling by a hash of the reversed bits (Laine-Karras permutation, with the
@@ -163,6 +176,22 @@ mod tests {
                 }
                 assert!(counts.iter().all(|&c| c == 1), "pixel {pixel}, {nx}x{ny}: {counts:?}");
             }
+        }
+    }
+
+    #[test]
+    fn table_driven_dimension_matches_bit_by_bit_definition() {
+        let mut v = [0u32; 32];
+        let mut m: u64 = 1;
+        for (k, d) in v.iter_mut().enumerate() {
+            *d = (m << (31 - k)) as u32;
+            m ^= m << 1;
+        }
+        let mut rng = Rng::new(1, 1);
+        for _ in 0..10_000 {
+            let i = rng.next_u32();
+            let slow = (0..32).filter(|b| i >> b & 1 == 1).fold(0, |r, b| r ^ v[b]);
+            assert_eq!(sobol_dim1(i), slow);
         }
     }
 
