@@ -43,7 +43,7 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, String> {
     }
 }
 
-/// A bare mesh file as a scene: the mesh in grey, lit by a white sky and a camera that
+/// A bare mesh file as a scene: the mesh in grey, lit by a grey sky and a sun, and a camera that
 /// frames it from the front (for `glint info mesh.obj` and quick previews).
 fn load_mesh_as_scene(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, String> {
     use crate::camera::{Camera, FovAxis};
@@ -59,7 +59,8 @@ fn load_mesh_as_scene(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, St
     for g in &groups {
         b.add_mesh_instance(&g.mesh, &Transform::IDENTITY, false, m, None, false)?;
     }
-    b.add_constant_environment(Rgb::WHITE);
+    b.add_constant_environment(Rgb::splat(0.4));
+    b.add_directional(Vec3 { x: 1.0, y: -2.0, z: -1.5 }, Rgb::splat(2.5));
     let bounds = groups.iter().fold(crate::math::Aabb::EMPTY, |a, g| a.union(g.mesh.bounds()));
     let centre = bounds.center();
     let radius = bounds.extent().length() * 0.5;
