@@ -212,3 +212,6 @@ impl Bsdf {
         }
     }
 }
+
+#[cfg(test)]
+mod chi2_tests;
