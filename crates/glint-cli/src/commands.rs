@@ -122,6 +122,11 @@ fn render_cmd(a: RenderArgs) -> Result<(), String> {
         glint::scene::json::check_resolution(w, h)?;
     }
     let (mut loaded, load_s) = load_scene(&a.scene, a.width, a.height)?;
+    if !a.quiet {
+        for w in &loaded.warnings {
+            eprintln!("glint: warning: {w}");
+        }
+    }
     if let Some(sel) = a.light_selection {
         loaded.scene.set_light_selection(sel);
     }

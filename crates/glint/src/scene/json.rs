@@ -636,7 +636,7 @@ pub fn load(path: &Path, text: &str, opts: &LoadOptions) -> Result<LoadedScene, 
         ..Default::default()
     };
     let scene = b.finish(camera, selection).map_err(|e| format!("{}: {e}", path.display()))?;
-    Ok(LoadedScene { scene, integrator, settings })
+    Ok(LoadedScene { scene, integrator, settings, warnings: Vec::new() })
 }
 
 /// serde_json appends " at line L column C"; the location is already at the front.

@@ -3,6 +3,7 @@
 
 mod builder;
 pub mod json;
+pub mod mitsuba;
 mod world;
 
 pub use builder::{Emission, LoadedGroup, SceneBuilder};
@@ -28,6 +29,8 @@ pub struct LoadedScene {
     pub scene: Scene,
     pub integrator: Integrator,
     pub settings: RenderSettings,
+    /// Things the loader accepted but could not honour exactly (printed by the CLI).
+    pub warnings: Vec<String>,
 }
 
 /// Loads a scene file, choosing the format by extension (`.json`; `.xml` for Mitsuba 3).
@@ -36,9 +39,13 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, String> {
     if ext == "obj" || ext == "ply" {
         return load_mesh_as_scene(path, opts);
     }
+    if ext == "xml" {
+        return mitsuba::load(path, opts);
+    }
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     match ext.as_str() {
         "json" => json::load(path, &text, opts),
+        "xml" => mitsuba::load(path, opts),
         _ => Err(format!("{}: unknown scene format (expected .json, .xml, .obj or .ply)", path.display())),
     }
 }
@@ -74,5 +81,6 @@ fn load_mesh_as_scene(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, St
         scene,
         integrator: Integrator::Path(crate::integrators::PathSettings::default()),
         settings: RenderSettings::default(),
+        warnings: Vec::new(),
     })
 }

@@ -1,0 +1,220 @@
+//! Mitsuba XML as a tree of elements, each remembering its file and line, with `<include>`
+//! expanded, `<default>` values collected and `$name` references substituted. Files written
+//! for Mitsuba 0.x get the renames Mitsuba 3 itself applies (camelCase parameter names to
+//! snake_case, `lookAt` to `lookat`, `srgb` to `rgb`).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+#[derive(Clone, Debug)]
+pub struct Element {
+    pub tag: String,
+    pub attrs: Vec<(String, String)>,
+    pub children: Vec<Element>,
+    pub file: Arc<PathBuf>,
+    pub line: usize,
+}
+
+impl Element {
+    pub fn attr(&self, name: &str) -> Option<&str> {
+        self.attrs.iter().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
+    }
+    /// "file:line: message".
+    pub fn err(&self, msg: impl std::fmt::Display) -> String {
+        format!("{}:{}: {}", self.file.display(), self.line, msg)
+    }
+    pub fn required(&self, name: &str) -> Result<&str, String> {
+        self.attr(name).ok_or_else(|| self.err(format!("<{}> needs a '{name}' attribute", self.tag)))
+    }
+}
+
+/// Parses one file into its root element (no includes or substitution yet).
+fn parse_file(path: &Path) -> Result<Element, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse_str(&text, path)
+}
+
+pub fn parse_str(text: &str, path: &Path) -> Result<Element, String> {
+    use quick_xml::events::Event;
+    let file = Arc::new(path.to_path_buf());
+    let line_starts: Vec<usize> = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
+    let line_at = |pos: usize| line_starts.partition_point(|&s| s <= pos);
+    let mut reader = quick_xml::Reader::from_str(text);
+    let mut stack: Vec<Element> = Vec::new();
+    let mut root: Option<Element> = None;
+    loop {
+        let before = reader.buffer_position() as usize;
+        let ev = reader.read_event().map_err(|e| {
+            format!("{}:{}: malformed XML: {e}", path.display(), line_at(reader.error_position() as usize))
+        })?;
+        // The event starts at the first '<' after the previous event.
+        let start = text[before..].find('<').map_or(before, |o| before + o);
+        let make = |e: &quick_xml::events::BytesStart| -> Result<Element, String> {
+            let tag = String::from_utf8_lossy(e.name().as_ref()).to_string();
+            let mut attrs = Vec::new();
+            for a in e.attributes() {
+                let a =
+                    a.map_err(|err| format!("{}:{}: malformed attribute: {err}", path.display(), line_at(start)))?;
+                let key = String::from_utf8_lossy(a.key.as_ref()).to_string();
+                let value = a
+                    .unescape_value()
+                    .map_err(|err| format!("{}:{}: malformed attribute: {err}", path.display(), line_at(start)))?
+                    .to_string();
+                attrs.push((key, value));
+            }
+            Ok(Element { tag, attrs, children: Vec::new(), file: file.clone(), line: line_at(start) })
+        };
+        match ev {
+            Event::Start(e) => stack.push(make(&e)?),
+            Event::Empty(e) => {
+                let el = make(&e)?;
+                match stack.last_mut() {
+                    Some(parent) => parent.children.push(el),
+                    None => root = Some(el),
+                }
+            }
+            Event::End(_) => {
+                let el = stack.pop().expect("quick-xml checks nesting");
+                match stack.last_mut() {
+                    Some(parent) => parent.children.push(el),
+                    None => root = Some(el),
+                }
+            }
+            Event::Eof => break,
+            Event::Text(t) => {
+                let s = String::from_utf8_lossy(t.as_ref()).to_string();
+                if !s.trim().is_empty() {
+                    return Err(format!("{}:{}: unexpected text '{}'", path.display(), line_at(start), s.trim()));
+                }
+            }
+            _ => {}
+        }
+    }
+    if !stack.is_empty() {
+        return Err(format!("{}:{}: malformed XML: <{}> is never closed", path.display(), stack[0].line, stack[0].tag));
+    }
+    root.ok_or_else(|| format!("{}: empty XML document", path.display()))
+}
+
+/// Loads a scene file: parses it, expands includes, applies version upgrades, collects
+/// defaults (overridden by `defines`) and substitutes `$name` references.
+pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, String> {
+    let mut root = parse_file(path)?;
+    if root.tag != "scene" {
+        return Err(root.err(format!("the root element is <{}>, expected <scene>", root.tag)));
+    }
+    let version = root.attr("version").unwrap_or("3.0.0").to_string();
+    let major: u32 = version
+        .split('.')
+        .next()
+        .and_then(|m| m.parse().ok())
+        .ok_or_else(|| root.err(format!("version '{version}' is not a version number")))?;
+    if major > 3 {
+        return Err(root.err(format!("scene version {version} is newer than the 3.x that glint reads")));
+    }
+    expand_includes(&mut root, 0)?;
+    if major < 2 {
+        upgrade_from_v0(&mut root);
+    }
+    let mut values: HashMap<String, String> = HashMap::new();
+    root.children.retain(|c| {
+        if c.tag == "default" {
+            if let (Some(n), Some(v)) = (c.attr("name"), c.attr("value")) {
+                values.entry(n.to_string()).or_insert_with(|| v.to_string());
+            }
+            false
+        } else {
+            true
+        }
+    });
+    for (k, v) in defines {
+        values.insert(k.clone(), v.clone());
+    }
+    substitute(&mut root, &values)?;
+    Ok(root)
+}
+
+fn expand_includes(el: &mut Element, depth: usize) -> Result<(), String> {
+    if depth > 16 {
+        return Err(el.err("includes nested more than 16 deep (a cycle?)"));
+    }
+    let mut out = Vec::with_capacity(el.children.len());
+    for mut c in std::mem::take(&mut el.children) {
+        if c.tag == "include" {
+            let name = c.required("filename")?;
+            let path = c.file.parent().unwrap_or(Path::new(".")).join(name);
+            if !path.exists() {
+                return Err(c.err(format!("included file '{}' does not exist", path.display())));
+            }
+            let mut inc = parse_file(&path)?;
+            expand_includes(&mut inc, depth + 1)?;
+            if inc.tag == "scene" {
+                out.extend(inc.children);
+            } else {
+                out.push(inc);
+            }
+        } else {
+            expand_includes(&mut c, depth)?;
+            out.push(c);
+        }
+    }
+    el.children = out;
+    Ok(())
+}
+
+fn snake_case(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 4);
+    for (i, ch) in s.chars().enumerate() {
+        if ch.is_ascii_uppercase() {
+            if i > 0 {
+                out.push('_');
+            }
+            out.push(ch.to_ascii_lowercase());
+        } else {
+            out.push(ch);
+        }
+    }
+    out
+}
+
+fn upgrade_from_v0(el: &mut Element) {
+    match el.tag.as_str() {
+        "lookAt" => el.tag = "lookat".into(),
+        "srgb" => el.tag = "rgb".into(),
+        _ => {}
+    }
+    for (k, v) in el.attrs.iter_mut() {
+        if k == "name" {
+            *v = match v.as_str() {
+                "toWorld" => "to_world".to_string(),
+                "toUV" => "to_uv".to_string(),
+                other => snake_case(other),
+            };
+        }
+    }
+    for c in el.children.iter_mut() {
+        upgrade_from_v0(c);
+    }
+}
+
+fn substitute(el: &mut Element, values: &HashMap<String, String>) -> Result<(), String> {
+    for (_, v) in el.attrs.iter_mut() {
+        while let Some(i) = v.find('$') {
+            let rest = &v[i + 1..];
+            let len = rest.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(rest.len());
+            let name = &rest[..len];
+            if name.is_empty() {
+                break;
+            }
+            let value = values.get(name).ok_or_else(|| {
+                format!("{}:{}: ${name} has no <default> and no -D {name}=...", el.file.display(), el.line)
+            })?;
+            *v = format!("{}{}{}", &v[..i], value, &rest[len..]);
+        }
+    }
+    for c in el.children.iter_mut() {
+        substitute(c, values)?;
+    }
+    Ok(())
+}
