@@ -94,7 +94,8 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjFile, String> {
                 } else {
                     parse_floats::<2>(path, line, &rest, "vt")?
                 };
-                uvs.push(t);
+                // Images are looked up top-down (row 0 first); OBJ's v points up.
+                uvs.push([t[0], 1.0 - t[1]]);
             }
             "usemtl" => {
                 let name = rest.join(" ");

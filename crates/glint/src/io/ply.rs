@@ -226,7 +226,8 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                         normals.push(Vec3 { x: vals[a] as f32, y: vals[b] as f32, z: vals[c] as f32 });
                     }
                     if let (Some(a), Some(b)) = (u, v) {
-                        uvs.push([vals[a] as f32, vals[b] as f32]);
+                        // Images are looked up top-down; PLY's v points up.
+                        uvs.push([vals[a] as f32, 1.0 - vals[b] as f32]);
                     }
                 }
             }

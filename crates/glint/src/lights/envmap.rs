@@ -57,14 +57,24 @@ impl EnvMap {
         (self.to_world.vector(d).normalize(), st)
     }
 
-    fn lookup(&self, uv: [f32; 2]) -> Rgb {
-        let x = ((uv[0] * self.image.width as f32) as usize).min(self.image.width - 1);
-        let y = ((uv[1] * self.image.height as f32) as usize).min(self.image.height - 1);
-        self.image.pixels[y * self.image.width + x] * self.scale
-    }
-
+    /// Bilinear interpolation between texel centres (wrapping in u, clamped in v), as
+    /// Mitsuba's envmap does. Sampling stays piecewise constant; `pdf` describes that.
     pub fn eval(&self, dir: Vec3) -> Rgb {
-        self.lookup(self.uv_from_dir(dir))
+        let uv = self.uv_from_dir(dir);
+        let (w, h) = (self.image.width as i64, self.image.height as i64);
+        let x = uv[0] * w as f32 - 0.5;
+        let y = uv[1] * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let texel = |xi: i64, yi: i64| {
+            let xi = xi.rem_euclid(w) as usize;
+            let yi = yi.clamp(0, h - 1) as usize;
+            self.image.pixels[yi * self.image.width + xi]
+        };
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let a = texel(x0, y0) * (1.0 - fx) + texel(x0 + 1, y0) * fx;
+        let b = texel(x0, y0 + 1) * (1.0 - fx) + texel(x0 + 1, y0 + 1) * fx;
+        (a * (1.0 - fy) + b * fy) * self.scale
     }
 
     pub fn pdf(&self, dir: Vec3) -> f32 {
@@ -94,6 +104,6 @@ impl EnvMap {
         if pdf <= 0.0 {
             return None;
         }
-        Some(LightSample { wi, radiance: self.lookup(uv), pdf, dist: f32::INFINITY, delta: false })
+        Some(LightSample { wi, radiance: self.eval(wi), pdf, dist: f32::INFINITY, delta: false })
     }
 }

@@ -116,16 +116,16 @@ impl Material {
     }
 }
 
-/// Complex refractive indices (eta, k) at RGB wavelengths for Mitsuba's named conductor
-/// presets, from the same measured data (Palik; averaged to sRGB primaries).
+/// Complex refractive indices (eta, k) in RGB for Mitsuba's named conductor presets: the
+/// values Mitsuba 3.9.1's `scalar_rgb` variant uses (read back from it with `mi.traverse`).
 pub fn conductor_preset(name: &str) -> Option<(Rgb, Rgb)> {
     use crate::math::rgb;
     Some(match name {
-        "Au" => (rgb(0.1431189557, 0.3749570432, 1.4424785571), rgb(3.9831604247, 2.3857207478, 1.6032152899)),
-        "Ag" => (rgb(0.1552646489, 0.1167232965, 0.1383806959), rgb(4.8283433224, 3.1222459278, 2.1469504455)),
-        "Cu" => (rgb(0.2004376970, 0.9240334304, 1.1022119527), rgb(3.9129485033, 2.4528477015, 2.1421879552)),
-        "Al" => (rgb(1.6574599595, 0.8803689579, 0.5212287346), rgb(9.2238691996, 6.2695232477, 4.8370012281)),
-        "Cr" => (rgb(4.3696828663, 2.9167024892, 1.6547005413), rgb(5.2064337956, 4.2313645277, 3.7549467933)),
+        "Au" => (rgb(0.143036, 0.375307, 1.44205), rgb(3.983, 2.38556, 1.60336)),
+        "Ag" => (rgb(0.155276, 0.116728, 0.138388), rgb(4.82835, 3.12222, 2.1469)),
+        "Cu" => (rgb(0.201005, 0.92375, 1.10222), rgb(3.91326, 2.45305, 2.14209)),
+        "Al" => (rgb(1.6575, 0.880405, 0.521244), rgb(9.22381, 6.2695, 4.837)),
+        "Cr" => (rgb(4.36967, 2.91651, 1.6549), rgb(5.20655, 4.23131, 3.7547)),
         "none" => (Rgb::BLACK, Rgb::WHITE),
         _ => return None,
     })

@@ -44,10 +44,11 @@ impl Bitmap {
         self.pixels[y * self.width + x]
     }
 
-    /// Bilinear lookup; uv (0,0) is the bottom-left of the image (v up, as OBJ and Mitsuba).
+    /// Bilinear lookup with wrap-around. uv (0,0) is the top-left of the image, as in
+    /// Mitsuba; mesh loaders flip OBJ/PLY's upward v to match (v' = 1 - v).
     pub fn eval(&self, uv: [f32; 2]) -> Rgb {
         let x = uv[0] * self.width as f32 - 0.5;
-        let y = (1.0 - uv[1]) * self.height as f32 - 0.5;
+        let y = uv[1] * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
@@ -70,7 +71,8 @@ pub enum Texture {
         uv_scale: [f32; 2],
         uv_offset: [f32; 2],
     },
-    /// Two colours in a checker of 2x2 squares over the unit uv square (Mitsuba's layout).
+    /// Two colours in a checker of 2x2 squares over the unit uv square, laid out as Mitsuba's:
+    /// `color0` where both or neither of the uv fractions exceed one half.
     Checkerboard {
         color0: Rgb,
         color1: Rgb,

@@ -1,0 +1,77 @@
+//! Bad Mitsuba XML gets a one-line error naming the file and line.
+
+use glint::scene::{load, LoadOptions};
+use std::path::PathBuf;
+
+fn write(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("glint-mitsuba-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="40"/>
+  <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>"#;
+
+fn error_of(name: &str, text: &str) -> String {
+    let p = write(name, text);
+    match load(&p, &LoadOptions::default()) {
+        Ok(_) => panic!("{name} loaded but should not"),
+        Err(e) => {
+            assert!(!e.contains('\n'), "not one line: {e}");
+            e
+        }
+    }
+}
+
+#[test]
+fn malformed_xml() {
+    let e = error_of("malformed.xml", "<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n</scene>\n");
+    assert!(e.contains("malformed.xml:") && e.contains("malformed XML"), "{e}");
+}
+
+#[test]
+fn unknown_plugin_names_type_file_and_line() {
+    let e = error_of(
+        "plugin.xml",
+        &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"sphere\">\n <bsdf type=\"velvet\"/>\n</shape>\n</scene>\n"),
+    );
+    assert!(e.contains("plugin.xml:5:") && e.contains("velvet"), "{e}");
+    let e = error_of("shape.xml", &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"hair\"/>\n</scene>\n"));
+    assert!(e.contains("shape.xml:4:") && e.contains("hair"), "{e}");
+}
+
+#[test]
+fn missing_referenced_file() {
+    let e = error_of(
+        "missing.xml",
+        &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"obj\">\n <string name=\"filename\" value=\"nowhere.obj\"/>\n</shape>\n</scene>\n"),
+    );
+    assert!(e.contains("missing.xml:4:") && e.contains("nowhere.obj"), "{e}");
+    let e = error_of("include.xml", "<scene version=\"3.0.0\">\n<include filename=\"gone.xml\"/>\n</scene>\n");
+    assert!(e.contains("include.xml:2:") && e.contains("gone.xml"), "{e}");
+}
+
+#[test]
+fn substitution_without_default() {
+    let e = error_of(
+        "subst.xml",
+        &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"sphere\">\n <float name=\"radius\" value=\"$r\"/>\n</shape>\n</scene>\n"),
+    );
+    assert!(e.contains("subst.xml:5:") && e.contains("$r"), "{e}");
+}
+
+#[test]
+fn defines_override_defaults_and_refs_resolve() {
+    let text = format!(
+        "<scene version=\"3.0.0\">\n<default name=\"r\" value=\"0.5\"/>\n{SENSOR}\n<bsdf type=\"diffuse\" id=\"m\"/>\n<shape type=\"sphere\">\n <float name=\"radius\" value=\"$r\"/>\n <ref id=\"m\"/>\n</shape>\n</scene>\n"
+    );
+    let p = write("ok.xml", &text);
+    let s = load(&p, &LoadOptions::default()).unwrap();
+    assert!((s.scene.spheres[0].radius - 0.5).abs() < 1e-6);
+    let s = load(&p, &LoadOptions { defines: vec![("r".into(), "2".into())], ..Default::default() }).unwrap();
+    assert!((s.scene.spheres[0].radius - 2.0).abs() < 1e-6);
+    let e = error_of("badref.xml", &text.replace("<ref id=\"m\"/>", "<ref id=\"nope\"/>"));
+    assert!(e.contains("badref.xml:8:") && e.contains("nope"), "{e}");
+}
