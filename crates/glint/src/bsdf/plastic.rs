@@ -2,8 +2,10 @@
 //! `roughplastic`). Light that enters the coating scatters off the base and may be reflected
 //! back by the coating many times; the sum of that series divides the diffuse albedo by
 //! (1 - F_dr), with F_dr the coating's diffuse internal reflectance, computed here by
-//! quadrature rather than a fitted polynomial. The rough variant uses the smooth Fresnel
-//! transmittance for the diffuse term (a close approximation of Mitsuba's tabulated one).
+//! the fitted polynomial Mitsuba uses. The rough variant replaces the smooth Fresnel terms by
+//! the rough interface's own transmittance, tabulated over the cosine at construction, and
+//! its internal reflectance (Mitsuba's `roughplastic` model), both integrated here with the
+//! rough dielectric BSDF.
 
 use super::{fresnel_dielectric, reflect_local, BsdfSample, Microfacet};
 use crate::math::{Rgb, Vec3, INV_PI};
@@ -19,6 +21,38 @@ pub struct PlasticParams {
     pub dist: Option<Microfacet>,
     /// Diffuse internal reflectance of the coating seen from inside.
     pub fdr_internal: f32,
+    /// Rough coatings: energy transmitted through the interface against the cosine of the
+    /// direction (TRANSMITTANCE_RES points over [0, 1]); `None` for smooth ones (1 - F).
+    pub transmittance: Option<[f32; TRANSMITTANCE_RES]>,
+}
+
+pub const TRANSMITTANCE_RES: usize = 64;
+
+/// Directional albedos of a rough dielectric interface seen from direction cosine `mu` on
+/// the side where the relative index is `eta`: (reflected, transmitted energy). Estimated by
+/// importance sampling the BSDF on a fixed stratified set of 4096 samples.
+fn rough_interface_albedo(dist: &Microfacet, eta: f32, mu: f32) -> (f32, f32) {
+    use super::microfacet::sample_rough_dielectric;
+    let wo = crate::math::Vec3 { x: (1.0 - mu * mu).max(0.0).sqrt(), y: 0.0, z: mu };
+    let n = 64;
+    let (mut r, mut t) = (0.0f64, 0.0f64);
+    for i in 0..n {
+        for j in 0..n {
+            let k = (i * n + j) as u32;
+            let u_lobe = (k.reverse_bits() as f64 / 4_294_967_296.0) as f32;
+            let u = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
+            if let Some(s) = sample_rough_dielectric(dist, eta, Rgb::WHITE, Rgb::WHITE, wo, u_lobe, u) {
+                if s.wi.z > 0.0 {
+                    r += s.weight.r as f64;
+                } else {
+                    // Undo the radiance scaling 1/eta^2: this is transmitted energy.
+                    t += (s.weight.r * eta * eta) as f64;
+                }
+            }
+        }
+    }
+    let m = (n * n) as f64;
+    ((r / m) as f32, (t / m) as f32)
 }
 
 /// Diffuse Fresnel reflectance: the cosine-weighted hemispherical average of Fresnel
@@ -38,7 +72,33 @@ pub fn diffuse_fresnel_reflectance(eta: f32) -> f32 {
 
 impl PlasticParams {
     pub fn new(diffuse: Rgb, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> PlasticParams {
-        PlasticParams { diffuse, specular, eta, dist, fdr_internal: diffuse_fresnel_reflectance(1.0 / eta) }
+        let (fdr_internal, transmittance) = match &dist {
+            None => (diffuse_fresnel_reflectance(1.0 / eta), None),
+            Some(d) => {
+                let mut table = [0.0f32; TRANSMITTANCE_RES];
+                let mut internal = 0.0f32;
+                for (i, t) in table.iter_mut().enumerate() {
+                    let mu = (i as f32 / (TRANSMITTANCE_RES - 1) as f32).max(1e-6);
+                    *t = rough_interface_albedo(d, eta, mu).1;
+                    internal += rough_interface_albedo(d, 1.0 / eta, mu).0 * mu;
+                }
+                (2.0 * internal / TRANSMITTANCE_RES as f32, Some(table))
+            }
+        };
+        PlasticParams { diffuse, specular, eta, dist, fdr_internal, transmittance }
+    }
+
+    /// Energy transmitted through the coating for direction cosine `cos`.
+    fn coating_transmittance(&self, cos: f32) -> f32 {
+        match &self.transmittance {
+            None => 1.0 - fresnel_dielectric(cos, self.eta).reflectance,
+            Some(t) => {
+                let x = cos.clamp(0.0, 1.0) * (TRANSMITTANCE_RES - 1) as f32;
+                let i = (x as usize).min(TRANSMITTANCE_RES - 2);
+                let f = x - i as f32;
+                t[i] * (1.0 - f) + t[i + 1] * f
+            }
+        }
     }
 
     pub fn is_delta_only(&self) -> bool {
@@ -69,10 +129,10 @@ impl PlasticParams {
     }
 
     fn diffuse_eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let fo = fresnel_dielectric(wo.z, self.eta).reflectance;
-        let fi = fresnel_dielectric(wi.z, self.eta).reflectance;
+        let to = self.coating_transmittance(wo.z);
+        let ti = self.coating_transmittance(wi.z);
         let albedo = self.diffuse / (1.0 - self.fdr_internal);
-        albedo * (INV_PI * wi.z * (1.0 - fo) * (1.0 - fi) / (self.eta * self.eta))
+        albedo * (INV_PI * wi.z * to * ti / (self.eta * self.eta))
     }
 
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {

@@ -57,13 +57,15 @@ impl EnvMap {
         (self.to_world.vector(d).normalize(), st)
     }
 
-    /// Bilinear interpolation between texel centres (wrapping in u, clamped in v), as
-    /// Mitsuba's envmap does. Sampling stays piecewise constant; `pdf` describes that.
+    /// Bilinear interpolation laid out as Mitsuba's envmap: columns are texel-centred and
+    /// wrap around in u, rows are vertices from the north pole (row 0, v = 0) to the south
+    /// pole (last row, v = 1). Sampling stays piecewise constant over texels; `pdf` describes
+    /// that, so the estimate is unbiased whatever the interpolation.
     pub fn eval(&self, dir: Vec3) -> Rgb {
         let uv = self.uv_from_dir(dir);
         let (w, h) = (self.image.width as i64, self.image.height as i64);
         let x = uv[0] * w as f32 - 0.5;
-        let y = uv[1] * h as f32 - 0.5;
+        let y = uv[1] * (h - 1).max(1) as f32;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let texel = |xi: i64, yi: i64| {

@@ -45,12 +45,10 @@ pub enum MaterialKind {
         reflect: Rgb,
         transmit: Rgb,
     },
+    /// Diffuse base under a coating; `params` holds everything but the textured albedo.
     Plastic {
         diffuse: Texture,
-        specular: Rgb,
-        eta: f32,
-        dist: Option<Microfacet>,
-        fdr_internal: f32,
+        params: PlasticParams,
     },
     Black,
 }
@@ -70,8 +68,7 @@ impl Material {
     }
 
     pub fn plastic(diffuse: Texture, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> MaterialKind {
-        let p = PlasticParams::new(Rgb::BLACK, specular, eta, dist);
-        MaterialKind::Plastic { diffuse, specular, eta, dist, fdr_internal: p.fdr_internal }
+        MaterialKind::Plastic { diffuse, params: PlasticParams::new(Rgb::BLACK, specular, eta, dist) }
     }
 
     /// True for materials that let light through (both faces are meaningful).
@@ -104,13 +101,9 @@ impl Material {
             MaterialKind::ThinDielectric { eta, reflect, transmit } => {
                 Bsdf::ThinDielectric { eta: *eta, reflect: *reflect, transmit: *transmit }
             }
-            MaterialKind::Plastic { diffuse, specular, eta, dist, fdr_internal } => Bsdf::Plastic(PlasticParams {
-                diffuse: diffuse.eval(uv),
-                specular: *specular,
-                eta: *eta,
-                dist: *dist,
-                fdr_internal: *fdr_internal,
-            }),
+            MaterialKind::Plastic { diffuse, params } => {
+                Bsdf::Plastic(PlasticParams { diffuse: diffuse.eval(uv), ..*params })
+            }
             MaterialKind::Black => Bsdf::Black,
         }
     }
