@@ -163,19 +163,52 @@ fn expand_includes(el: &mut Element, depth: usize) -> Result<(), String> {
     Ok(())
 }
 
+/// `sampleCount` to `sample_count`, `intIOR` to `int_ior`: a run of capitals is one word.
 fn snake_case(s: &str) -> String {
     let mut out = String::with_capacity(s.len() + 4);
-    for (i, ch) in s.chars().enumerate() {
+    let mut prev_lower = false;
+    for ch in s.chars() {
         if ch.is_ascii_uppercase() {
-            if i > 0 {
+            if prev_lower {
                 out.push('_');
             }
             out.push(ch.to_ascii_lowercase());
+            prev_lower = false;
         } else {
             out.push(ch);
+            prev_lower = ch.is_ascii_lowercase() || ch.is_ascii_digit();
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn old_parameter_names_become_snake_case() {
+        assert_eq!(snake_case("intIOR"), "int_ior");
+        assert_eq!(snake_case("sampleCount"), "sample_count");
+        assert_eq!(snake_case("specularReflectance"), "specular_reflectance");
+        assert_eq!(snake_case("fov"), "fov");
+    }
+
+    #[test]
+    fn version_0_6_scene_is_upgraded() {
+        let text = r#"<scene version="0.6.0"><default name="d" value="3"/>
+            <shape type="sphere"><transform name="toWorld"><lookAt origin="0,0,1" target="0,0,0" up="0,1,0"/></transform>
+            <float name="radius" value="$d"/></shape></scene>"#;
+        let dir = std::env::temp_dir().join(format!("glint-xml-v06-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("old.xml");
+        std::fs::write(&p, text).unwrap();
+        let root = load_tree(&p, &[]).unwrap();
+        let shape = &root.children[0];
+        assert_eq!(shape.children[0].attr("name"), Some("to_world"));
+        assert_eq!(shape.children[0].children[0].tag, "lookat");
+        assert_eq!(shape.children[1].attr("value"), Some("3"));
+    }
 }
 
 fn upgrade_from_v0(el: &mut Element) {
