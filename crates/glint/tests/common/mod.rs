@@ -1,0 +1,6 @@
+//! Support code shared by the validation tests (each test binary uses a part of it).
+#![allow(dead_code)]
+
+pub mod bsdf_check;
+pub mod scenes;
+pub mod stats;
