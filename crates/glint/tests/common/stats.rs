@@ -168,3 +168,37 @@ pub fn block_estimates(out: &RenderOutput, c: usize, block: usize) -> Vec<Estima
     }
     v
 }
+
+/// Checks a render whose every pixel has the same expected value `exact` (channel 0): the
+/// whole-image mean and each `block`×`block` block mean must lie within `k` standard errors.
+/// Returns a description of each failure.
+pub fn check_constant_image(label: &str, out: &RenderOutput, exact: f64, block: usize, k: f64) -> Vec<String> {
+    let mut failures = Vec::new();
+    let whole = image_estimate(out, 0);
+    println!(
+        "{label}: mean {:.5} ± {:.5} (exact {exact:.5}, z = {:.2})",
+        whole.mean,
+        whole.se,
+        (whole.mean - exact) / whole.se
+    );
+    let mut check = |what: String, e: Estimate| {
+        if !((e.mean - exact).abs() <= k * e.se) {
+            failures.push(format!(
+                "{label}: {what} mean {:.5} ± {:.5}, exact {exact:.5} ({:.1} standard errors, limit {k:.2})",
+                e.mean,
+                e.se,
+                (e.mean - exact) / e.se
+            ));
+        }
+    };
+    check("image".into(), whole);
+    for (i, e) in block_estimates(out, 0, block).into_iter().enumerate() {
+        check(format!("block {i}"), e);
+    }
+    failures
+}
+
+/// Number of comparisons `check_constant_image` makes.
+pub fn constant_image_comparisons(out_width: usize, out_height: usize, block: usize) -> usize {
+    1 + (out_width / block) * (out_height / block)
+}

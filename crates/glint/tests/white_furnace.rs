@@ -1,0 +1,91 @@
+//! White furnace tests: scenes whose radiance is known everywhere.
+//! - Albedo-1 diffuse objects (an open box with a ball in it) inside a uniform environment
+//!   Le reflect exactly what they receive, so every pixel is Le.
+//! - Inside a closed enclosure whose walls (and a ball within) all emit Le and reflect with
+//!   albedo a, radiance is Le + a·L everywhere, so L = Le / (1 - a).
+//! Every path strategy and Russian roulette setting must agree with the exact value, each
+//! whole-image and 4×4-block mean within a critical number of standard errors.
+
+mod common;
+
+use common::scenes::{add_square, camera, diffuse, emission, render_with};
+use common::stats::{check_constant_image, constant_image_comparisons, z_critical, FALSE_ALARM};
+use glint::accel::BvhSplit;
+use glint::geometry::cube_mesh;
+use glint::integrators::{Integrator, PathSettings, Strategy};
+use glint::materials::{Material, MaterialKind, Texture};
+use glint::math::{vec3, Rgb, Transform, Vec3};
+use glint::scene::{LightSelection, Scene, SceneBuilder};
+use std::sync::Arc;
+
+const SIZE: u32 = 16;
+const BLOCK: usize = 4;
+const SPP: u32 = 256;
+
+/// Every strategy, each with the default Russian roulette (throughput-based, from depth 5)
+/// and an aggressive one (fixed survival 0.6 from the first bounce).
+fn integrators() -> Vec<(String, Integrator)> {
+    let mut v = Vec::new();
+    for strategy in [Strategy::Mis, Strategy::Light, Strategy::Bsdf] {
+        v.push((
+            format!("{strategy:?}, default roulette"),
+            Integrator::Path(PathSettings { strategy, ..Default::default() }),
+        ));
+        v.push((
+            format!("{strategy:?}, roulette p=0.6 from depth 1"),
+            Integrator::Path(PathSettings { strategy, rr_depth: 1, rr_probability: Some(0.6), ..Default::default() }),
+        ));
+    }
+    v
+}
+
+fn check_all(scene: &Scene, exact: f64) {
+    let integrators = integrators();
+    let k =
+        z_critical(FALSE_ALARM, integrators.len() * constant_image_comparisons(SIZE as usize, SIZE as usize, BLOCK));
+    let mut failures = Vec::new();
+    for (i, (name, integrator)) in integrators.iter().enumerate() {
+        let out = render_with(scene, integrator, SPP, 100 + i as u64);
+        failures.extend(check_constant_image(name, &out, exact, BLOCK, k));
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn albedo_one_objects_in_a_uniform_environment_look_like_the_environment() {
+    let le = 0.5;
+    let mut b = SceneBuilder::new(BvhSplit::Sah);
+    let white = diffuse(&mut b, "white", Rgb::WHITE);
+    // A box open at the top (paths bounce many times inside) with a ball in it.
+    add_square(&mut b, vec3(0.0, -1.0, 0.0), 1, 1.0, 1.0, white, None);
+    add_square(&mut b, vec3(0.0, 0.0, -1.0), 2, 1.0, 1.0, white, None);
+    add_square(&mut b, vec3(0.0, 0.0, 1.0), 2, -1.0, 1.0, white, None);
+    add_square(&mut b, vec3(-1.0, 0.0, 0.0), 0, 1.0, 1.0, white, None);
+    add_square(&mut b, vec3(1.0, 0.0, 0.0), 0, -1.0, 1.0, white, None);
+    b.add_sphere(vec3(0.2, -0.5, 0.1), 0.5, &Transform::IDENTITY, white, None, false).unwrap();
+    b.add_constant_environment(Rgb::splat(le));
+    let cam = camera(vec3(0.5, 3.0, 2.5), vec3(0.0, -0.4, 0.0), Vec3::Y, 45.0, SIZE, SIZE);
+    let scene = b.finish(cam, LightSelection::Power).unwrap();
+    check_all(&scene, le as f64);
+}
+
+#[test]
+fn emitting_enclosure_of_albedo_a_has_radiance_le_over_one_minus_a() {
+    let (le, a) = (1.0f32, 0.5f32);
+    let mut b = SceneBuilder::new(BvhSplit::Sah);
+    // One-sided, so that a wrongly oriented wall would show up black.
+    let wall = b.add_material(Material::new(
+        "wall",
+        MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(a)) },
+        false,
+    ));
+    // The walls of a cube facing inwards, and a ball: two lights, so the light-selection
+    // probabilities matter.
+    let xf = Transform::scale(Vec3::splat(2.0)).unwrap();
+    b.add_mesh_instance(&Arc::new(cube_mesh(BvhSplit::Sah)), &xf, false, wall, emission(le), true).unwrap();
+    b.add_sphere(vec3(0.3, -0.2, 0.0), 0.8, &Transform::IDENTITY, wall, emission(le), false).unwrap();
+    let cam = camera(vec3(-0.5, 0.5, -1.9), vec3(0.2, -0.2, 0.0), Vec3::Y, 70.0, SIZE, SIZE);
+    let scene = b.finish(cam, LightSelection::Power).unwrap();
+    assert_eq!(scene.lights.len(), 2);
+    check_all(&scene, (le / (1.0 - a)) as f64);
+}
