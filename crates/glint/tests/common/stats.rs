@@ -127,10 +127,16 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// z-score of the difference between two independent estimates.
+    /// z-score of the difference between two independent estimates (0 for two identical
+    /// noiseless ones, such as two black regions).
     pub fn z_against(&self, other: &Estimate) -> f64 {
         let se = (self.se * self.se + other.se * other.se).sqrt();
-        (self.mean - other.mean) / se
+        let diff = self.mean - other.mean;
+        if diff == 0.0 {
+            0.0
+        } else {
+            diff / se
+        }
     }
 }
 
