@@ -103,6 +103,11 @@ pub fn add_box(b: &mut SceneBuilder, size: Vec3, rotate_y: f32, at: Vec3, materi
 /// A Cornell-like box: white floor, ceiling and back wall, red left and green right walls,
 /// two white boxes and a small square light under the ceiling. Open at the front.
 pub fn cornell_box(width: u32, height: u32) -> Scene {
+    cornell_box_with(width, height, |_| {})
+}
+
+/// The Cornell-like box with more objects added by `extra`.
+pub fn cornell_box_with(width: u32, height: u32, extra: impl FnOnce(&mut SceneBuilder)) -> Scene {
     let mut b = SceneBuilder::new(BvhSplit::Sah);
     let white = diffuse(&mut b, "white", Rgb::splat(0.73));
     let red = diffuse(&mut b, "red", Rgb { r: 0.63, g: 0.065, b: 0.05 });
@@ -116,6 +121,7 @@ pub fn cornell_box(width: u32, height: u32) -> Scene {
     add_square(&mut b, vec3(0.0, 1.98, 0.0), 1, -1.0, 0.25, light, emission(17.0));
     add_box(&mut b, vec3(0.3, 0.3, 0.3), -17.0, vec3(0.33, 0.3, 0.35), white);
     add_box(&mut b, vec3(0.3, 0.6, 0.3), 18.0, vec3(-0.33, 0.6, -0.3), white);
+    extra(&mut b);
     let cam = camera(vec3(0.0, 1.0, 3.9), vec3(0.0, 1.0, 0.0), Vec3::Y, 39.0, width, height);
     b.finish(cam, LightSelection::Power).unwrap()
 }
