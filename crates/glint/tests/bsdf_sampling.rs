@@ -102,9 +102,8 @@ fn report(failures: Vec<String>) {
     assert!(failures.is_empty(), "{} case(s) failed:\n{}", failures.len(), failures.join("\n"));
 }
 
-#[test]
-fn sampled_directions_follow_the_pdf() {
-    let all = checked();
+/// The chi-square battery on `all`, failures described.
+fn chi2_failures(all: &[Checked]) -> Vec<String> {
     let alpha = sidak(CHI2_SIGNIFICANCE, all.len());
     let mut failures = Vec::new();
     for c in all {
@@ -118,7 +117,27 @@ fn sampled_directions_follow_the_pdf() {
             }
         }
     }
-    report(failures);
+    failures
+}
+
+#[test]
+fn sampled_directions_follow_the_pdf() {
+    report(chi2_failures(checked()));
+}
+
+#[test]
+#[ignore = "long: run with `cargo test -- --ignored`"]
+fn sampled_directions_follow_the_pdf_with_16_times_the_samples() {
+    let all: Vec<Checked> = cases()
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, case)| {
+            let samples = draw_samples(&case, 16 * SAMPLES, 5000 + i as u64);
+            let integrals = integrate(&case);
+            Checked { case, samples, integrals }
+        })
+        .collect();
+    report(chi2_failures(&all));
 }
 
 #[test]

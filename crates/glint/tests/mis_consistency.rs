@@ -17,6 +17,8 @@ use glint::scene::{Emission, LightSelection, Scene, SceneBuilder};
 const SIZE: u32 = 32;
 const BLOCK: usize = 8;
 const SPP: u32 = 256;
+/// For the `#[ignore]`d long run.
+const LONG_SPP: u32 = 8192;
 const STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::Light, Strategy::Bsdf];
 
 fn glossy(b: &mut SceneBuilder, name: &str) -> u32 {
@@ -45,13 +47,13 @@ fn scene() -> Scene {
 
 /// Renders `scene` with each strategy (seeds differ, so estimates are independent) and
 /// compares every pair on the whole image and on each block, channel by channel.
-fn assert_strategies_agree(scene: &Scene, settings: PathSettings) {
+fn assert_strategies_agree(scene: &Scene, settings: PathSettings, spp: u32) {
     let estimates: Vec<(Strategy, Vec<[Estimate; 3]>)> = STRATEGIES
         .iter()
         .enumerate()
         .map(|(i, &strategy)| {
             let integrator = Integrator::Path(PathSettings { strategy, ..settings.clone() });
-            let out = render_with(scene, &integrator, SPP, 500 + i as u64);
+            let out = render_with(scene, &integrator, spp, 500 + i as u64);
             let per_channel: Vec<Vec<Estimate>> = (0..3)
                 .map(|c| std::iter::once(image_estimate(&out, c)).chain(block_estimates(&out, c, BLOCK)).collect())
                 .collect();
@@ -92,13 +94,13 @@ fn assert_strategies_agree(scene: &Scene, settings: PathSettings) {
 
 #[test]
 fn strategies_agree_on_glossy_and_diffuse_surfaces() {
-    assert_strategies_agree(&scene(), PathSettings::default());
+    assert_strategies_agree(&scene(), PathSettings::default(), SPP);
 }
 
 #[test]
 fn strategies_agree_at_a_fixed_depth() {
     // Depth 3: direct light and one indirect bounce, and nothing more, in every strategy.
-    assert_strategies_agree(&scene(), PathSettings { max_depth: Some(3), ..Default::default() });
+    assert_strategies_agree(&scene(), PathSettings { max_depth: Some(3), ..Default::default() }, SPP);
 }
 
 #[test]
@@ -116,5 +118,11 @@ fn strategies_agree_on_emitters_seen_from_behind() {
     add_quad(&mut b, facing_camera, lamp, Some(Emission { radiance: Rgb::splat(3.0), two_sided: false }));
     let cam = camera(vec3(0.0, 2.0, 4.0), vec3(0.0, 0.3, 0.0), Vec3::Y, 50.0, SIZE, SIZE);
     let scene = b.finish(cam, LightSelection::Power).unwrap();
-    assert_strategies_agree(&scene, PathSettings::default());
+    assert_strategies_agree(&scene, PathSettings::default(), SPP);
+}
+
+#[test]
+#[ignore = "long: run with `cargo test -- --ignored`"]
+fn strategies_agree_with_many_samples() {
+    assert_strategies_agree(&scene(), PathSettings::default(), LONG_SPP);
 }

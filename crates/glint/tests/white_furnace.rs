@@ -21,6 +21,8 @@ use std::sync::Arc;
 const SIZE: u32 = 16;
 const BLOCK: usize = 4;
 const SPP: u32 = 256;
+/// For the `#[ignore]`d long runs, 32 times the samples: 5.7 times smaller errors.
+const LONG_SPP: u32 = 8192;
 
 /// Every strategy, each with three kinds of Russian roulette: the default (throughput-based
 /// from depth 5), throughput-based from the first bounce, and a fixed survival probability
@@ -43,21 +45,23 @@ fn integrators(p: f32) -> Vec<(String, Integrator)> {
     v
 }
 
-fn check_all(scene: &Scene, exact: f64, roulette_p: f32) {
+fn check_all(scene: &Scene, exact: f64, roulette_p: f32, spp: u32) {
     let integrators = integrators(roulette_p);
     let k =
         z_critical(FALSE_ALARM, integrators.len() * constant_image_comparisons(SIZE as usize, SIZE as usize, BLOCK));
     let mut failures = Vec::new();
     for (i, (name, integrator)) in integrators.iter().enumerate() {
-        let out = render_with(scene, integrator, SPP, 100 + i as u64);
+        let out = render_with(scene, integrator, spp, 100 + i as u64);
         failures.extend(check_constant_image(name, &out, exact, BLOCK, k));
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-#[test]
-fn albedo_one_objects_in_a_uniform_environment_look_like_the_environment() {
-    let le = 0.5;
+/// Radiance of the environment around the open box.
+const ENV: f32 = 0.5;
+
+fn open_box_in_environment() -> Scene {
+    let le = ENV;
     let mut b = SceneBuilder::new(BvhSplit::Sah);
     let white = diffuse(&mut b, "white", Rgb::WHITE);
     // A box open at the top (paths bounce many times inside) with a ball in it.
@@ -69,13 +73,15 @@ fn albedo_one_objects_in_a_uniform_environment_look_like_the_environment() {
     b.add_sphere(vec3(0.2, -0.5, 0.1), 0.5, &Transform::IDENTITY, white, None, false).unwrap();
     b.add_constant_environment(Rgb::splat(le));
     let cam = camera(vec3(0.5, 3.0, 2.5), vec3(0.0, -0.4, 0.0), Vec3::Y, 45.0, SIZE, SIZE);
-    let scene = b.finish(cam, LightSelection::Power).unwrap();
-    check_all(&scene, le as f64, 0.95);
+    b.finish(cam, LightSelection::Power).unwrap()
 }
 
-#[test]
-fn emitting_enclosure_of_albedo_a_has_radiance_le_over_one_minus_a() {
-    let (le, a) = (1.0f32, 0.5f32);
+/// Emission and albedo of the enclosure.
+const LE: f32 = 1.0;
+const ALBEDO: f32 = 0.5;
+
+fn emitting_enclosure() -> Scene {
+    let (le, a) = (LE, ALBEDO);
     let mut b = SceneBuilder::new(BvhSplit::Sah);
     // One-sided, so that a wrongly oriented surface would show up black.
     let wall = b.add_material(Material::new(
@@ -94,5 +100,22 @@ fn emitting_enclosure_of_albedo_a_has_radiance_le_over_one_minus_a() {
     let cam = camera(vec3(-0.8, 0.8, -1.8), vec3(0.2, -0.3, 0.0), Vec3::Y, 70.0, SIZE, SIZE);
     let scene = b.finish(cam, LightSelection::Power).unwrap();
     assert_eq!(scene.lights.len(), 2);
-    check_all(&scene, (le / (1.0 - a)) as f64, 0.6);
+    scene
+}
+
+#[test]
+fn albedo_one_objects_in_a_uniform_environment_look_like_the_environment() {
+    check_all(&open_box_in_environment(), ENV as f64, 0.95, SPP);
+}
+
+#[test]
+fn emitting_enclosure_of_albedo_a_has_radiance_le_over_one_minus_a() {
+    check_all(&emitting_enclosure(), (LE / (1.0 - ALBEDO)) as f64, 0.6, SPP);
+}
+
+#[test]
+#[ignore = "long: run with `cargo test -- --ignored`"]
+fn furnaces_hold_with_many_samples() {
+    check_all(&open_box_in_environment(), ENV as f64, 0.95, LONG_SPP);
+    check_all(&emitting_enclosure(), (LE / (1.0 - ALBEDO)) as f64, 0.6, LONG_SPP);
 }
