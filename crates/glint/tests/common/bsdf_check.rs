@@ -35,7 +35,8 @@ pub fn dir(theta_deg: f32) -> Vec3 {
 }
 
 fn bin_of(w: Vec3) -> usize {
-    let theta = w.z.clamp(-1.0, 1.0).acos() as f64;
+    // In f64: an f32 acos rounds directions just above the horizon to π/2 or beyond.
+    let theta = (w.z as f64).clamp(-1.0, 1.0).acos();
     let mut phi = (w.y as f64).atan2(w.x as f64);
     if phi < 0.0 {
         phi += 2.0 * std::f64::consts::PI;
