@@ -63,15 +63,17 @@ pub(crate) fn spawn_ray(si: &SurfaceInteraction, dir: Vec3) -> Ray {
     Ray::new(offset_origin(si.p, si.ng, dir), dir)
 }
 
-/// A shadow ray from `si` towards a point `dist` away along `dir` (stops just short of it).
+/// A shadow ray from `si` towards the point `dist` away along `dir` (stops just short of it).
+/// The ray aims at that point from the offset origin: keeping `dir` from there would miss
+/// the point, and where the light surface is oblique to the ray it would hit the light
+/// itself well before `dist` and count it as an occluder.
 #[inline]
 pub(crate) fn shadow_ray(si: &SurfaceInteraction, dir: Vec3, dist: f32) -> Ray {
     let o = offset_origin(si.p, si.ng, dir);
-    let t_max = if dist.is_finite() {
-        let remaining = dist - (o - si.p).dot(dir);
-        remaining * (1.0 - 1e-4)
-    } else {
-        f32::INFINITY
-    };
-    Ray::segment(o, dir, t_max)
+    if !dist.is_finite() {
+        return Ray::segment(o, dir, f32::INFINITY);
+    }
+    let to_target = si.p + dir * dist - o;
+    let len = to_target.length();
+    Ray::segment(o, to_target / len, len * (1.0 - 1e-4))
 }

@@ -72,6 +72,8 @@ pub enum Light {
         instance: u32,
         sphere: Sphere,
         radiance: Rgb,
+        /// Normals flipped: the sphere emits into its inside only (otherwise outside only).
+        inward: bool,
     },
     /// Uniform radiance from every direction.
     Constant {
@@ -169,7 +171,7 @@ impl Light {
                 let pdf = dist2 / (cos_l.abs() * emitter.total_area);
                 Some(LightSample { wi, radiance: *radiance, pdf, dist, delta: false })
             }
-            Light::Sphere { sphere, radiance, .. } => sample_sphere(sphere, *radiance, p, u),
+            Light::Sphere { sphere, radiance, inward, .. } => sample_sphere(sphere, *radiance, *inward, p, u),
             Light::Constant { radiance, .. } => {
                 let wi = warp::uniform_sphere(u);
                 Some(LightSample {
@@ -246,11 +248,16 @@ fn spot_falloff(cos_t: f32, cutoff: f32, beam: f32) -> f32 {
 }
 
 /// Cone sampling of a sphere seen from outside (pbrt's approach), uniform area from inside.
-fn sample_sphere(s: &Sphere, radiance: Rgb, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+/// A sphere emits on one side only: nothing reaches `p` from the other.
+fn sample_sphere(s: &Sphere, radiance: Rgb, inward: bool, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
     let to_c = s.center - p;
     let dc2 = to_c.length_squared();
     let r2 = s.radius * s.radius;
-    if dc2 <= r2 * 1.0001 {
+    let inside = dc2 <= r2 * 1.0001;
+    if inside != inward {
+        return None;
+    }
+    if inside {
         // Inside (or on) the sphere: sample its area uniformly.
         let n = warp::uniform_sphere(u);
         let q = s.center + n * s.radius;
@@ -263,10 +270,6 @@ fn sample_sphere(s: &Sphere, radiance: Rgb, p: Vec3, u: [f32; 2]) -> Option<Ligh
         let wi = d / dist;
         let cos_l = n.dot(wi).abs();
         if cos_l == 0.0 {
-            return None;
-        }
-        // From inside, the outward-facing sphere emits nothing towards p.
-        if n.dot(wi) < 0.0 {
             return None;
         }
         return Some(LightSample { wi, radiance, pdf: dist2 / (cos_l * s.area()), dist, delta: false });

@@ -248,7 +248,12 @@ impl SceneBuilder {
         self.spheres.push(sphere);
         let instance = self.instances.len() as u32;
         let light = emission.map(|e| {
-            self.lights.push(PendingLight::Ready(Light::Sphere { instance, sphere, radiance: e.radiance }));
+            self.lights.push(PendingLight::Ready(Light::Sphere {
+                instance,
+                sphere,
+                radiance: e.radiance,
+                inward: flip_normals,
+            }));
             self.lights.len() as u32 - 1
         });
         self.instances.push(Instance {

@@ -1,0 +1,7 @@
+//! Support code shared by the validation tests (each test binary uses a part of it).
+#![allow(dead_code)]
+
+pub mod analytic;
+pub mod bsdf_check;
+pub mod scenes;
+pub mod stats;
