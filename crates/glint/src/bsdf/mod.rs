@@ -213,5 +213,3 @@ impl Bsdf {
     }
 }
 
-#[cfg(test)]
-mod chi2_tests;
