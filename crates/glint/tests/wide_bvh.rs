@@ -112,11 +112,18 @@ fn every_triangle_is_in_exactly_one_block_lane() {
             (0..3000).map(|i| ((i % 17) as f32 * 0.3, (i % 7) as f32 * 0.2, (i % 13) as f32 * 0.1)).collect();
         let mesh = mesh_from(&pts, &[0.5, -0.2], accel);
         let blocks = match &mesh.wide {
-            glint::geometry::WideTris::W4(w) => w.blocks.clone(),
-            glint::geometry::WideTris::W8(w) => w.blocks.clone(),
+            glint::geometry::WideTris::W4(w) => w.blocks().to_vec(),
+            glint::geometry::WideTris::W8(w) => w.blocks().to_vec(),
             glint::geometry::WideTris::None => unreachable!(),
         };
-        let mut seen: Vec<u32> = blocks.iter().flat_map(|b| b.prim).filter(|&p| p != u32::MAX).collect();
+        // Unused lanes repeat the block's first triangle.
+        let mut seen: Vec<u32> = blocks
+            .iter()
+            .flat_map(|b| {
+                let used = 1 + b.prim[1..].iter().position(|&p| p == b.prim[0]).unwrap_or(3);
+                b.prim[..used].to_vec()
+            })
+            .collect();
         seen.sort();
         assert_eq!(seen, (0..mesh.indices.len() as u32).collect::<Vec<_>>());
     }

@@ -1,7 +1,8 @@
 //! Triangles in blocks of four, structure-of-arrays, in leaf order: what the wide BVH's
 //! leaves point to. A block holds its own copy of the vertices (no index indirection on the
-//! hot path) and the original triangle numbers. Unused lanes hold NaN vertices, which no
-//! ray can hit (every comparison with NaN is false).
+//! hot path) and the original triangle numbers. Unused lanes repeat the block's first
+//! triangle (same vertices, same number), so they change no answer (the first of equal
+//! lanes wins) and let a block that the ray misses be rejected early.
 
 use super::triangle::ShearedRay;
 use crate::math::{Ray, Vec3};
@@ -21,7 +22,8 @@ impl Tri4 {
     pub fn pack(tris: &[(u32, [Vec3; 3])]) -> Tri4 {
         debug_assert!(!tris.is_empty() && tris.len() <= 4);
         let mut b = Tri4::EMPTY;
-        for (lane, (prim, verts)) in tris.iter().enumerate() {
+        for lane in 0..4 {
+            let (prim, verts) = &tris[if lane < tris.len() { lane } else { 0 }];
             b.prim[lane] = *prim;
             for (k, p) in verts.iter().enumerate() {
                 for axis in 0..3 {

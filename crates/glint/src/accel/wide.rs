@@ -104,9 +104,10 @@ pub const FAR_SCALE: f32 = 1.000_000_24;
 
 #[derive(Clone, Debug, Default)]
 pub struct WideBvh<const W: usize> {
-    pub nodes: Vec<WideNode<W>>,
+    /// Private: traversal relies on every child reference being in range.
+    nodes: Vec<WideNode<W>>,
     /// The root: a node index, or a leaf when the whole tree is one leaf.
-    pub root: u32,
+    root: u32,
     pub bounds: Aabb,
     /// Longest root-to-leaf path, in wide nodes (sizes the traversal stack).
     pub depth: usize,
@@ -123,6 +124,36 @@ pub struct WideStats {
     pub node_bytes: usize,
     /// Mean number of used child slots per node.
     pub fill: f64,
+}
+
+/// What closest-hit traversal does at a leaf: test items `first..first + count`, shorten
+/// `ray.t_max` on a hit and say whether there was one. A trait rather than a closure so that
+/// implementations can be `#[inline(always)]`: a call per leaf would spill the vector
+/// registers that hold the ray.
+pub trait ClosestLeaf {
+    fn test(&mut self, first: u32, count: u32, ray: &mut Ray) -> bool;
+}
+
+/// What any-hit traversal does at a leaf: true if anything blocks the ray.
+pub trait AnyLeaf {
+    fn test(&mut self, first: u32, count: u32, ray: &Ray) -> bool;
+}
+
+/// Closures work too (the scene's top level uses them; a call per instance is cheap there).
+pub struct FnLeaf<F>(pub F);
+
+impl<F: FnMut(u32, u32, &mut Ray) -> bool> ClosestLeaf for FnLeaf<F> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, ray: &mut Ray) -> bool {
+        (self.0)(first, count, ray)
+    }
+}
+
+impl<F: FnMut(u32, u32, &Ray) -> bool> AnyLeaf for FnLeaf<F> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, ray: &Ray) -> bool {
+        (self.0)(first, count, ray)
+    }
 }
 
 /// Traversal stack size in entries; a wide tree deeper than this allows is rejected at build.
@@ -181,6 +212,14 @@ impl<const W: usize> WideBvh<W> {
         out
     }
 
+    pub fn nodes(&self) -> &[WideNode<W>] {
+        &self.nodes
+    }
+
+    pub fn root(&self) -> u32 {
+        self.root
+    }
+
     pub fn stats(&self, leaf_items: impl Fn(u32) -> f64) -> WideStats {
         let mut s = WideStats {
             depth: self.depth,
@@ -219,13 +258,12 @@ impl<const W: usize> WideBvh<W> {
         s
     }
 
-    /// Closest-hit traversal. `leaf(first, count, ray)` tests a leaf's items, shortens
-    /// `ray.t_max` on a hit and returns whether it hit.
+    /// Closest-hit traversal; `leaf` tests a leaf's items (see [`ClosestLeaf`]).
     ///
     /// # Safety
     /// `S` must be available on this CPU (see [`Isa`]).
     #[inline(always)]
-    pub unsafe fn traverse<S: Isa>(&self, ray: &mut Ray, mut leaf: impl FnMut(u32, u32, &mut Ray) -> bool) -> bool {
+    pub unsafe fn traverse<S: Isa>(&self, ray: &mut Ray, leaf: &mut impl ClosestLeaf) -> bool {
         if self.root == EMPTY_CHILD {
             return false;
         }
@@ -236,7 +274,8 @@ impl<const W: usize> WideBvh<W> {
         let mut found = false;
         loop {
             if cur & LEAF_BIT == 0 {
-                let node = &self.nodes[cur as usize];
+                // SAFETY: child references are built by `collapse` and always in range.
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
                 let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
                 if mask != 0 {
@@ -251,12 +290,15 @@ impl<const W: usize> WideBvh<W> {
                     let base = sp;
                     let mut push = |c: u32, d: f32, sp: &mut usize| {
                         let mut j = *sp;
-                        // SAFETY: entries base..sp were written above.
-                        while j > base && unsafe { stack[j - 1].assume_init() }.1 < d {
-                            stack[j] = stack[j - 1];
-                            j -= 1;
+                        // SAFETY: entries base..sp were written above, and `collapse`
+                        // rejects trees deep enough to overflow the stack.
+                        unsafe {
+                            while j > base && stack.get_unchecked(j - 1).assume_init().1 < d {
+                                *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
+                                j -= 1;
+                            }
+                            stack.get_unchecked_mut(j).write((c, d));
                         }
-                        stack[j].write((c, d));
                         *sp += 1;
                     };
                     push(node.children[first], dist[first], &mut sp);
@@ -267,12 +309,12 @@ impl<const W: usize> WideBvh<W> {
                     }
                     sp -= 1;
                     // SAFETY: written by `push`.
-                    cur = unsafe { stack[sp].assume_init() }.0;
+                    cur = unsafe { stack.get_unchecked(sp).assume_init() }.0;
                     continue;
                 }
             } else {
                 let (first, count) = leaf_range(cur);
-                found |= leaf(first, count, ray);
+                found |= leaf.test(first, count, ray);
             }
             // Pop, skipping entries that lie beyond the closest hit so far.
             loop {
@@ -281,7 +323,7 @@ impl<const W: usize> WideBvh<W> {
                 }
                 sp -= 1;
                 // SAFETY: every entry below `sp` was written.
-                let (c, d) = unsafe { stack[sp].assume_init() };
+                let (c, d) = unsafe { stack.get_unchecked(sp).assume_init() };
                 if d <= ray.t_max * FAR_SCALE {
                     cur = c;
                     break;
@@ -290,12 +332,12 @@ impl<const W: usize> WideBvh<W> {
         }
     }
 
-    /// Any-hit traversal: true as soon as `leaf(first, count, ray)` reports a hit.
+    /// Any-hit traversal: true as soon as `leaf` reports a hit.
     ///
     /// # Safety
     /// `S` must be available on this CPU (see [`Isa`]).
     #[inline(always)]
-    pub unsafe fn occluded<S: Isa>(&self, ray: &Ray, mut leaf: impl FnMut(u32, u32, &Ray) -> bool) -> bool {
+    pub unsafe fn occluded<S: Isa>(&self, ray: &Ray, leaf: &mut impl AnyLeaf) -> bool {
         if self.root == EMPTY_CHILD {
             return false;
         }
@@ -305,14 +347,16 @@ impl<const W: usize> WideBvh<W> {
         let mut cur = self.root;
         loop {
             if cur & LEAF_BIT == 0 {
-                let node = &self.nodes[cur as usize];
+                // SAFETY: child references are built by `collapse` and always in range.
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
                 let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
                 if mask != 0 {
                     cur = node.children[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
                     while mask != 0 {
-                        stack[sp].write(node.children[mask.trailing_zeros() as usize]);
+                        // SAFETY: `collapse` rejects trees deep enough to overflow the stack.
+                        unsafe { stack.get_unchecked_mut(sp) }.write(node.children[mask.trailing_zeros() as usize]);
                         sp += 1;
                         mask &= mask - 1;
                     }
@@ -320,7 +364,7 @@ impl<const W: usize> WideBvh<W> {
                 }
             } else {
                 let (first, count) = leaf_range(cur);
-                if leaf(first, count, ray) {
+                if leaf.test(first, count, ray) {
                     return true;
                 }
             }
@@ -329,7 +373,7 @@ impl<const W: usize> WideBvh<W> {
             }
             sp -= 1;
             // SAFETY: every entry below `sp` was written.
-            cur = unsafe { stack[sp].assume_init() };
+            cur = unsafe { stack.get_unchecked(sp).assume_init() };
         }
     }
 }

@@ -8,12 +8,57 @@ use super::simd::{Isa, Scalar, SimdPath};
 use super::tri4::{Tri4, TriRay};
 use super::triangle::TriangleHit;
 use super::wide::{leaf_ref, WideBvh, WideStats, LEAF_BIT};
+use super::wide::{AnyLeaf, ClosestLeaf};
 use crate::math::{Ray, Vec3};
+use std::marker::PhantomData;
+
+/// Closest hit among a leaf's blocks of four.
+struct Closest<'a, S> {
+    blocks: &'a [Tri4],
+    tr: TriRay,
+    best: Option<(u32, TriangleHit)>,
+    isa: PhantomData<S>,
+}
+
+impl<S: Isa> ClosestLeaf for Closest<'_, S> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, r: &mut Ray) -> bool {
+        let mut hit = false;
+        // SAFETY: leaf ranges are built by `build` and always in range; `S` is available
+        // (the only callers are `intersect_generic`'s, which require it).
+        for b in unsafe { self.blocks.get_unchecked(first as usize..(first + count) as usize) } {
+            let h = unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) };
+            if let Some(lane) = h.nearest() {
+                r.t_max = h.t[lane];
+                self.best = Some((b.prim[lane], TriangleHit { t: h.t[lane], b1: h.b1[lane], b2: h.b2[lane] }));
+                hit = true;
+            }
+        }
+        hit
+    }
+}
+
+/// Any hit among a leaf's blocks of four.
+struct Any<'a, S> {
+    blocks: &'a [Tri4],
+    tr: TriRay,
+    isa: PhantomData<S>,
+}
+
+impl<S: Isa> AnyLeaf for Any<'_, S> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, r: &Ray) -> bool {
+        // SAFETY: as for `Closest`.
+        let blocks = unsafe { self.blocks.get_unchecked(first as usize..(first + count) as usize) };
+        blocks.iter().any(|b| unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) }.mask != 0)
+    }
+}
 
 #[derive(Clone, Debug, Default)]
 pub struct TriangleWideBvh<const W: usize> {
-    pub tree: WideBvh<W>,
-    pub blocks: Vec<Tri4>,
+    /// Private: traversal relies on leaf ranges being in range of `blocks`.
+    tree: WideBvh<W>,
+    blocks: Vec<Tri4>,
 }
 
 impl<const W: usize> TriangleWideBvh<W> {
@@ -33,13 +78,21 @@ impl<const W: usize> TriangleWideBvh<W> {
         TriangleWideBvh { tree, blocks }
     }
 
+    pub fn tree(&self) -> &WideBvh<W> {
+        &self.tree
+    }
+
+    pub fn blocks(&self) -> &[Tri4] {
+        &self.blocks
+    }
+
     pub fn stats(&self) -> WideStats {
         // SAH in triangle tests: a block of four costs one test on the SIMD paths.
         self.tree.stats(|leaf| super::wide::leaf_range(leaf).1 as f64)
     }
 
     pub fn bytes(&self) -> usize {
-        self.tree.nodes.len() * std::mem::size_of::<super::wide::WideNode<W>>()
+        self.tree.nodes().len() * std::mem::size_of::<super::wide::WideNode<W>>()
             + self.blocks.len() * std::mem::size_of::<Tri4>()
     }
 
@@ -97,35 +150,19 @@ impl<const W: usize> TriangleWideBvh<W> {
 
     #[inline(always)]
     unsafe fn intersect_generic<S: Isa>(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
-        let tr = TriRay::new(ray);
-        let mut best = None;
-        self.tree.traverse::<S>(ray, |first, count, r| {
-            let mut hit = false;
-            for b in &self.blocks[first as usize..(first + count) as usize] {
-                let h = S::tri4(b, &tr, r.t_min, r.t_max);
-                if let Some(lane) = h.nearest() {
-                    r.t_max = h.t[lane];
-                    best = Some((b.prim[lane], TriangleHit { t: h.t[lane], b1: h.b1[lane], b2: h.b2[lane] }));
-                    hit = true;
-                }
-            }
-            hit
-        });
-        best
+        let mut leaf = Closest::<S> { blocks: &self.blocks, tr: TriRay::new(ray), best: None, isa: PhantomData };
+        self.tree.traverse::<S>(ray, &mut leaf);
+        leaf.best
     }
 
     #[inline(always)]
     unsafe fn occluded_generic<S: Isa>(&self, ray: &Ray) -> bool {
-        let tr = TriRay::new(ray);
-        self.tree.occluded::<S>(ray, |first, count, r| {
-            self.blocks[first as usize..(first + count) as usize]
-                .iter()
-                .any(|b| S::tri4(b, &tr, r.t_min, r.t_max).mask != 0)
-        })
+        let mut leaf = Any::<S> { blocks: &self.blocks, tr: TriRay::new(ray), isa: PhantomData };
+        self.tree.occluded::<S>(ray, &mut leaf)
     }
 
     /// Whether the tree is a single leaf (tiny meshes).
     pub fn is_single_leaf(&self) -> bool {
-        self.tree.root & LEAF_BIT != 0
+        self.tree.root() & LEAF_BIT != 0
     }
 }

@@ -22,7 +22,10 @@ unsafe impl Isa for Avx2 {
         let (t_min, t_max, scale) = (_mm256_set1_ps(r.t_min), _mm256_set1_ps(t_max), _mm256_set1_ps(FAR_SCALE));
         for c in 0..W / 8 {
             let slab = |row: usize, a: usize| {
-                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds[row].as_ptr().add(8 * c)), o[a]), inv[a])
+                _mm256_mul_ps(
+                    _mm256_sub_ps(_mm256_load_ps(node.bounds.get_unchecked(row).as_ptr().add(8 * c)), o[a]),
+                    inv[a],
+                )
             };
             let t_near = _mm256_max_ps(
                 slab(r.near[0], 0),

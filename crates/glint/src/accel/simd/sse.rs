@@ -40,7 +40,10 @@ unsafe impl Isa for Sse {
 #[inline(always)]
 pub(super) unsafe fn tri4_sse(b: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> Tri4Hits {
     let [kx, ky, kz] = r.k;
-    let rel = |k: usize, axis: usize| _mm_sub_ps(_mm_load_ps(b.v[k][axis].as_ptr()), _mm_set1_ps(r.o[axis]));
+    // SAFETY: `TriRay` axes are < 3.
+    let rel = |k: usize, axis: usize| {
+        _mm_sub_ps(_mm_load_ps(b.v[k].get_unchecked(axis).as_ptr()), _mm_set1_ps(*r.o.get_unchecked(axis)))
+    };
     let (a_x, a_y, a_z) = (rel(0, kx), rel(0, ky), rel(0, kz));
     let (b_x, b_y, b_z) = (rel(1, kx), rel(1, ky), rel(1, kz));
     let (c_x, c_y, c_z) = (rel(2, kx), rel(2, ky), rel(2, kz));
@@ -56,15 +59,21 @@ pub(super) unsafe fn tri4_sse(b: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> T
     let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
     let zero = _mm_setzero_ps();
     let any_zero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero));
-    if _mm_movemask_ps(any_zero) != 0 {
+    let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
+    let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
+    let inside = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_castsi128_ps(_mm_set1_epi32(-1)));
+    let zero_bits = _mm_movemask_ps(any_zero);
+    if zero_bits | _mm_movemask_ps(inside) == 0 {
+        // Most blocks: the ray passes outside every triangle.
+        return Tri4Hits { mask: 0, t: [0.0; 4], b1: [0.0; 4], b2: [0.0; 4] };
+    }
+    if zero_bits != 0 {
         // An edge function is exactly zero (ray through an edge or vertex): the reference
         // redoes it in double precision; so do we, lane by lane.
         return tri4_scalar(b, r, t_min, t_max);
     }
-    let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
-    let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
     let det = _mm_add_ps(_mm_add_ps(u, v), w);
-    let mut ok = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpneq_ps(det, zero));
+    let mut ok = _mm_and_ps(inside, _mm_cmpneq_ps(det, zero));
     let t_scaled = _mm_add_ps(
         _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, a_z)), _mm_mul_ps(v, _mm_mul_ps(sz, b_z))),
         _mm_mul_ps(w, _mm_mul_ps(sz, c_z)),
