@@ -3,6 +3,7 @@
 
 mod bvh;
 pub mod simd;
+mod top_level;
 pub mod tri4;
 mod triangle;
 pub mod wide;
@@ -10,6 +11,7 @@ mod wide_mesh;
 
 pub use bvh::{BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
 pub use simd::SimdPath;
+pub use top_level::TopLevelBvh;
 pub use triangle::{intersect_triangle, ShearedRay, TriangleHit};
 pub use wide::{WideBvh, WideStats};
 pub use wide_mesh::TriangleWideBvh;
