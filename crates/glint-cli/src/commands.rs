@@ -1,4 +1,4 @@
-//! Subcommands: `render`, `info`.
+//! Subcommands: `render`, `info`, `bench`, `rays`.
 
 use clap::{Args, Parser, Subcommand};
 use glint::accel::BvhSplit;
@@ -24,6 +24,10 @@ enum Command {
     Render(RenderArgs),
     /// Print scene statistics: shapes, triangles, lights, BVH quality and memory.
     Info(InfoArgs),
+    /// Measure ray throughput (closest hit and occlusion) on a mesh and a ray file.
+    Bench(crate::bench::BenchArgs),
+    /// Write a benchmark ray set (primary or diffuse rays) for a mesh.
+    Rays(crate::rays::RaysArgs),
 }
 
 #[derive(Args)]
@@ -99,6 +103,8 @@ pub fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
         Command::Render(a) => render_cmd(a),
         Command::Info(a) => info_cmd(a),
+        Command::Bench(a) => crate::bench::bench_cmd(a),
+        Command::Rays(a) => crate::rays::rays_cmd(a),
     }
 }
 

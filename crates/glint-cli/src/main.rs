@@ -1,6 +1,9 @@
 //! The `glint` command line: a thin front end over the `glint` library.
 
+mod bench;
 mod commands;
+mod meshsrc;
+mod rays;
 
 use clap::Parser;
 

@@ -59,7 +59,6 @@ pub struct Bvh {
 pub const SAH_TRAVERSAL_COST: f32 = 1.0;
 pub const SAH_INTERSECT_COST: f32 = 1.0;
 const BINS: usize = 16;
-const MAX_LEAF: usize = 8;
 /// Subtrees above this size are built in parallel.
 const PARALLEL_THRESHOLD: usize = 4096;
 
@@ -74,6 +73,30 @@ pub struct BvhStats {
     pub mean_leaf: f64,
     pub sah_cost: f64,
     pub bytes: usize,
+}
+
+/// Leaf-size policy of a build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BuildOptions {
+    /// Largest leaf the SAH may choose to make.
+    pub max_leaf: usize,
+    /// Nodes of this many primitives or fewer always become leaves.
+    pub leaf_at_most: usize,
+}
+
+impl BuildOptions {
+    /// The reference binary BVH: leaves of up to 8 where the SAH says a leaf is cheaper.
+    pub const BINARY: BuildOptions = BuildOptions { max_leaf: 8, leaf_at_most: 1 };
+    /// The tree the wide BVH is collapsed from: leaves of at most 4 triangles (one SIMD
+    /// block), and every node of 4 or fewer is a leaf, since testing a block of four costs
+    /// about what testing one triangle does.
+    pub const WIDE: BuildOptions = BuildOptions { max_leaf: 4, leaf_at_most: 4 };
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions::BINARY
+    }
 }
 
 struct BuildRef {
@@ -92,6 +115,11 @@ impl Bvh {
     /// Builds over `bounds[i]` for each primitive `i`. Empty boxes are allowed (degenerate
     /// triangles) and end up in leaves that no ray can hit.
     pub fn build(bounds: &[Aabb], split: BvhSplit) -> Bvh {
+        Bvh::build_with(bounds, split, BuildOptions::BINARY)
+    }
+
+    /// Builds with a given leaf-size policy.
+    pub fn build_with(bounds: &[Aabb], split: BvhSplit, opts: BuildOptions) -> Bvh {
         if bounds.is_empty() {
             return Bvh::default();
         }
@@ -104,7 +132,7 @@ impl Bvh {
                 index: i as u32,
             })
             .collect();
-        let tree = build_subtree(&mut refs, split);
+        let tree = build_subtree(&mut refs, split, opts);
         Bvh { nodes: tree.nodes, prim_indices: tree.prims }
     }
 
@@ -235,14 +263,14 @@ impl Bvh {
     }
 }
 
-fn build_subtree(refs: &mut [BuildRef], split: BvhSplit) -> Subtree {
+fn build_subtree(refs: &mut [BuildRef], split: BvhSplit, opts: BuildOptions) -> Subtree {
     let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds));
     let n = refs.len();
     let make_leaf = |refs: &mut [BuildRef]| Subtree {
         nodes: vec![BvhNode { bounds, first: 0, count: refs.len() as u32 }],
         prims: refs.iter().map(|r| r.index).collect(),
     };
-    if n == 1 {
+    if n <= opts.leaf_at_most.max(1) {
         return make_leaf(refs);
     }
     let centre_bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.grow(r.centre));
@@ -261,7 +289,7 @@ fn build_subtree(refs: &mut [BuildRef], split: BvhSplit) -> Subtree {
         BvhSplit::Sah => {
             if extent <= 0.0 {
                 // All centres coincide: no split separates them.
-                if n <= MAX_LEAF {
+                if n <= opts.max_leaf {
                     return make_leaf(refs);
                 }
                 n / 2
@@ -269,7 +297,7 @@ fn build_subtree(refs: &mut [BuildRef], split: BvhSplit) -> Subtree {
                 match best_sah_split(refs, &centre_bounds, bounds.area()) {
                     Some((axis, pos, cost)) => {
                         let leaf_cost = SAH_INTERSECT_COST * n as f32;
-                        if cost >= leaf_cost && n <= MAX_LEAF {
+                        if cost >= leaf_cost && n <= opts.max_leaf {
                             return make_leaf(refs);
                         }
                         let m = partition(refs, |r| bin_of(r.centre[axis], &centre_bounds, axis) < pos);
@@ -287,9 +315,9 @@ fn build_subtree(refs: &mut [BuildRef], split: BvhSplit) -> Subtree {
 
     let (left, right) = refs.split_at_mut(mid);
     let (l, r) = if n > PARALLEL_THRESHOLD {
-        rayon::join(|| build_subtree(left, split), || build_subtree(right, split))
+        rayon::join(|| build_subtree(left, split, opts), || build_subtree(right, split, opts))
     } else {
-        (build_subtree(left, split), build_subtree(right, split))
+        (build_subtree(left, split, opts), build_subtree(right, split, opts))
     };
     // Layout: [node, left child, right child, rest of left subtree..., rest of right subtree...]
     // so that siblings are adjacent.

@@ -1,7 +1,17 @@
-//! Acceleration structures: the binary SAH BVH (the reference), and triangle intersection.
+//! Acceleration structures: the binary SAH BVH (the reference), the wide SIMD BVH collapsed
+//! from it, and triangle intersection.
 
 mod bvh;
+pub mod simd;
+mod top_level;
+pub mod tri4;
 mod triangle;
+pub mod wide;
+mod wide_mesh;
 
-pub use bvh::{Bvh, BvhNode, BvhSplit, BvhStats, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
+pub use bvh::{BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
+pub use simd::SimdPath;
+pub use top_level::TopLevelBvh;
 pub use triangle::{intersect_triangle, ShearedRay, TriangleHit};
+pub use wide::{WideBvh, WideStats};
+pub use wide_mesh::TriangleWideBvh;

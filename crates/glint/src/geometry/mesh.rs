@@ -1,7 +1,43 @@
 //! Triangle meshes with their own bottom-level BVH.
 
-use crate::accel::{intersect_triangle, Bvh, BvhSplit, ShearedRay, TriangleHit};
+use crate::accel::{
+    intersect_triangle, BuildOptions, Bvh, BvhSplit, ShearedRay, SimdPath, TriangleHit, TriangleWideBvh, WideStats,
+};
 use crate::math::{Aabb, Ray, Vec3};
+
+/// Which acceleration structure a mesh traces with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum MeshAccel {
+    /// The binary BVH alone: the reference.
+    Binary,
+    Wide4,
+    /// 8-wide: the default (faster than 4-wide on the AVX2 machines measured, BENCHMARKS.md).
+    #[default]
+    Wide8,
+}
+
+/// The wide tree a mesh traces, if any.
+#[derive(Clone, Debug, Default)]
+pub enum WideTris {
+    #[default]
+    None,
+    W4(TriangleWideBvh<4>),
+    W8(TriangleWideBvh<8>),
+}
+
+/// Size and quality of a mesh's acceleration structure, for `glint bench`.
+#[derive(Clone, Debug)]
+pub struct AccelStats {
+    pub kind: String,
+    /// Bytes of what traversal reads: nodes plus (for wide trees) triangle blocks.
+    pub bytes: usize,
+    /// SAH cost of the traced tree (traversal steps and triangle tests, binary units).
+    pub sah_cost: f64,
+    /// SAH cost of the binary tree it was built as.
+    pub binary_sah_cost: f64,
+    pub nodes: usize,
+    pub leaves: usize,
+}
 
 #[derive(Clone, Debug, Default)]
 pub struct TriangleMesh {
@@ -10,7 +46,10 @@ pub struct TriangleMesh {
     pub normals: Option<Vec<Vec3>>,
     pub uvs: Option<Vec<[f32; 2]>>,
     pub indices: Vec<[u32; 3]>,
+    /// The binary BVH: the reference, and the tree the wide one is collapsed from.
     pub bvh: Bvh,
+    /// The wide BVH that `intersect` and `occluded` use, when built.
+    pub wide: WideTris,
 }
 
 impl TriangleMesh {
@@ -39,14 +78,51 @@ impl TriangleMesh {
         if let Some(p) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("vertex {p} is not finite"));
         }
-        let mut mesh = TriangleMesh { positions, normals, uvs, indices, bvh: Bvh::default() };
+        let mut mesh = TriangleMesh { positions, normals, uvs, indices, bvh: Bvh::default(), wide: WideTris::None };
         mesh.build_bvh(split);
         Ok(mesh)
     }
 
     pub fn build_bvh(&mut self, split: BvhSplit) {
+        self.build_accel(split, MeshAccel::default());
+    }
+
+    /// Builds the binary BVH and, unless `accel` is `Binary`, the wide one from it.
+    pub fn build_accel(&mut self, split: BvhSplit, accel: MeshAccel) {
         let bounds: Vec<Aabb> = (0..self.indices.len()).map(|i| self.triangle_bounds(i)).collect();
-        self.bvh = Bvh::build(&bounds, split);
+        let opts = if accel == MeshAccel::Binary { BuildOptions::BINARY } else { BuildOptions::WIDE };
+        self.bvh = Bvh::build_with(&bounds, split, opts);
+        let verts = |i: u32| self.vertices(i as usize);
+        self.wide = match accel {
+            MeshAccel::Binary => WideTris::None,
+            MeshAccel::Wide4 => WideTris::W4(TriangleWideBvh::build(&self.bvh, verts)),
+            MeshAccel::Wide8 => WideTris::W8(TriangleWideBvh::build(&self.bvh, verts)),
+        };
+    }
+
+    pub fn accel_stats(&self) -> AccelStats {
+        let b = self.bvh.stats();
+        let wide = |kind: &str, s: WideStats, bytes: usize| AccelStats {
+            kind: kind.into(),
+            bytes,
+            sah_cost: s.sah_cost,
+            binary_sah_cost: b.sah_cost,
+            nodes: s.nodes,
+            leaves: s.leaves,
+        };
+        match &self.wide {
+            WideTris::None => AccelStats {
+                kind: "binary".into(),
+                // What the binary traversal reads: nodes, indices and the indexed vertices.
+                bytes: b.bytes + self.indices.len() * 12 + self.positions.len() * 12,
+                sah_cost: b.sah_cost,
+                binary_sah_cost: b.sah_cost,
+                nodes: b.nodes,
+                leaves: b.leaves,
+            },
+            WideTris::W4(w) => wide("wide4", w.stats(), w.bytes()),
+            WideTris::W8(w) => wide("wide8", w.stats(), w.bytes()),
+        }
     }
 
     #[inline(always)]
@@ -78,6 +154,36 @@ impl TriangleMesh {
     /// Closest hit: (triangle, hit). Shortens `ray.t_max`.
     #[inline]
     pub fn intersect(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
+        self.intersect_with(ray, SimdPath::detect())
+    }
+
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_with(ray, SimdPath::detect())
+    }
+
+    /// Closest hit through a given SIMD path (all paths give the same answer).
+    #[inline]
+    pub fn intersect_with(&self, ray: &mut Ray, path: SimdPath) -> Option<(u32, TriangleHit)> {
+        match &self.wide {
+            WideTris::W8(w) => w.intersect(ray, path),
+            WideTris::W4(w) => w.intersect(ray, path),
+            WideTris::None => self.intersect_reference(ray),
+        }
+    }
+
+    #[inline]
+    pub fn occluded_with(&self, ray: &Ray, path: SimdPath) -> bool {
+        match &self.wide {
+            WideTris::W8(w) => w.occluded(ray, path),
+            WideTris::W4(w) => w.occluded(ray, path),
+            WideTris::None => self.occluded_reference(ray),
+        }
+    }
+
+    /// Closest hit through the binary BVH: the reference implementation.
+    #[inline]
+    pub fn intersect_reference(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
         let sh = ShearedRay::new(ray.dir);
         let mut best = None;
         self.bvh.traverse(ray, |tri, r| {
@@ -94,7 +200,7 @@ impl TriangleMesh {
     }
 
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    pub fn occluded_reference(&self, ray: &Ray) -> bool {
         let sh = ShearedRay::new(ray.dir);
         self.bvh.occluded(ray, |tri, r| {
             let [a, b, c] = self.vertices(tri as usize);

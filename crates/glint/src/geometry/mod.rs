@@ -3,5 +3,5 @@
 mod mesh;
 mod sphere;
 
-pub use mesh::{cube_mesh, disk_mesh, quad_mesh, TriangleMesh};
+pub use mesh::{cube_mesh, disk_mesh, quad_mesh, AccelStats, MeshAccel, TriangleMesh, WideTris};
 pub use sphere::Sphere;

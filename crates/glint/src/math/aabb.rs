@@ -54,8 +54,13 @@ impl Aabb {
     pub fn intersect(&self, ray: &Ray, inv_dir: Vec3) -> Option<f32> {
         let t0 = (self.min - ray.origin) * inv_dir;
         let t1 = (self.max - ray.origin) * inv_dir;
-        let tmin = t0.min(t1).max_component().max(ray.t_min);
-        let tmax = t0.max(t1).min_component().min(ray.t_max);
+        // 0 * inf = NaN when the ray runs exactly in the plane of a face (a zero direction
+        // component): the ray is then inside that slab's closed interval, so the axis must not
+        // constrain the interval (f32::min/max would turn NaN into a spurious bound).
+        let lo = |a: f32, b: f32| if a.is_nan() || b.is_nan() { f32::NEG_INFINITY } else { a.min(b) };
+        let hi = |a: f32, b: f32| if a.is_nan() || b.is_nan() { f32::INFINITY } else { a.max(b) };
+        let tmin = lo(t0.x, t1.x).max(lo(t0.y, t1.y)).max(lo(t0.z, t1.z)).max(ray.t_min);
+        let tmax = hi(t0.x, t1.x).min(hi(t0.y, t1.y)).min(hi(t0.z, t1.z)).min(ray.t_max);
         // Scale tmax up by 2 ulp-ish so that boxes that are flat in one axis and rays that
         // touch them exactly are not lost to rounding (Ize 2013, "Robust BVH ray traversal").
         if tmin <= tmax * 1.000_000_24 {

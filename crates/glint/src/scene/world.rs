@@ -5,7 +5,7 @@
 //! costs its memory once. Traversal returns a cheap [`Hit`]; the full
 //! [`SurfaceInteraction`] is computed only for the hit that is shaded.
 
-use crate::accel::{Bvh, BvhSplit};
+use crate::accel::{BvhSplit, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{Sphere, TriangleMesh};
 use crate::lights::Light;
@@ -84,7 +84,8 @@ pub struct Scene {
     pub meshes: Vec<Arc<TriangleMesh>>,
     pub spheres: Vec<Sphere>,
     pub instances: Vec<Instance>,
-    pub top: Bvh,
+    /// Over instances: the binary reference and the 8-wide tree that traversal uses.
+    pub top: TopLevelBvh,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     /// Indices of infinite lights that a escaping ray sees (constant, envmap).
@@ -102,7 +103,7 @@ impl Scene {
     /// scene builder after all instances and lights are in place.
     pub fn finish(&mut self, selection: LightSelection) {
         let boxes: Vec<Aabb> = self.instances.iter().map(|i| i.bounds).collect();
-        self.top = Bvh::build(&boxes, self.bvh_split);
+        self.top = TopLevelBvh::build(&boxes, self.bvh_split);
         self.bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
         self.set_light_selection(selection);
     }

@@ -1,0 +1,383 @@
+//! A W-wide BVH (W = 4 or 8) collapsed from the binary SAH BVH, with child boxes stored
+//! structure-of-arrays so that one SIMD instruction handles one slab of all children.
+//!
+//! Collapse (as in Embree's BVH4/8 and tinybvh): a wide node takes the children of a binary
+//! node and keeps replacing its largest-area interior child by that child's two children
+//! until it has W children or only leaves. Traversal visits hit children nearest first and
+//! culls popped entries that lie beyond the closest hit found so far.
+//!
+//! The tree does not know what its leaves hold: a leaf is a range `(first, count)` of
+//! "items" (blocks of four triangles for a mesh, primitive indices for the scene's top
+//! level) that the caller's closure tests.
+
+use super::bvh::{Bvh, BvhNode, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
+use super::simd::Isa;
+use crate::math::{Aabb, Ray};
+use std::mem::MaybeUninit;
+
+/// Child reference: a node index, or (top bit set) a leaf with `count - 1` in bits 27..31
+/// and `first` in bits 0..27.
+pub const LEAF_BIT: u32 = 1 << 31;
+const COUNT_SHIFT: u32 = 27;
+const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
+/// Most items one leaf can reference.
+pub const MAX_LEAF_ITEMS: usize = 16;
+const EMPTY_CHILD: u32 = u32::MAX;
+
+#[inline(always)]
+pub fn leaf_ref(first: usize, count: usize) -> u32 {
+    assert!(count >= 1 && count <= MAX_LEAF_ITEMS && first <= FIRST_MASK as usize, "leaf out of range");
+    LEAF_BIT | ((count as u32 - 1) << COUNT_SHIFT) | first as u32
+}
+
+#[inline(always)]
+pub fn leaf_range(child: u32) -> (u32, u32) {
+    (child & FIRST_MASK, ((child >> COUNT_SHIFT) & 0xF) + 1)
+}
+
+/// One node: `bounds[0..3]` are the children's min x, y, z and `bounds[3..6]` their max x,
+/// y, z, each an array over children. Unused slots hold an empty box, which no ray hits.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct WideNode<const W: usize> {
+    pub bounds: [[f32; W]; 6],
+    pub children: [u32; W],
+}
+
+impl<const W: usize> WideNode<W> {
+    const EMPTY: WideNode<W> = WideNode {
+        bounds: [
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+        ],
+        children: [EMPTY_CHILD; W],
+    };
+
+    fn set_child(&mut self, i: usize, b: &Aabb, child: u32) {
+        for a in 0..3 {
+            self.bounds[a][i] = b.min[a];
+            self.bounds[3 + a][i] = b.max[a];
+        }
+        self.children[i] = child;
+    }
+
+    pub fn child_bounds(&self, i: usize) -> Aabb {
+        let v = |r: usize| crate::math::vec3(self.bounds[r][i], self.bounds[r + 1][i], self.bounds[r + 2][i]);
+        Aabb { min: v(0), max: v(3) }
+    }
+}
+
+/// Per-ray constants of the box test. `near[a]` is the row of `bounds` that the ray enters
+/// through on axis `a` (min when the direction is positive), `far[a]` the one it leaves by,
+/// so the test needs no min/max per slab.
+#[derive(Clone, Copy, Debug)]
+pub struct NodeRay {
+    pub o: [f32; 3],
+    pub inv: [f32; 3],
+    pub near: [usize; 3],
+    pub far: [usize; 3],
+    pub t_min: f32,
+}
+
+impl NodeRay {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> NodeRay {
+        let inv = [1.0 / ray.dir.x, 1.0 / ray.dir.y, 1.0 / ray.dir.z];
+        let neg = |a: usize| inv[a].is_sign_negative() as usize;
+        NodeRay {
+            o: ray.origin.to_array(),
+            inv,
+            near: [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)],
+            far: [3 - 3 * neg(0), 4 - 3 * neg(1), 5 - 3 * neg(2)],
+            t_min: ray.t_min,
+        }
+    }
+}
+
+/// Widening of the far distance that keeps boxes touched exactly by a ray (flat boxes,
+/// rounding) from being missed; the same factor as the binary BVH's slab test.
+pub const FAR_SCALE: f32 = 1.000_000_24;
+
+#[derive(Clone, Debug, Default)]
+pub struct WideBvh<const W: usize> {
+    /// Private: traversal relies on every child reference being in range.
+    nodes: Vec<WideNode<W>>,
+    /// The root: a node index, or a leaf when the whole tree is one leaf.
+    root: u32,
+    pub bounds: Aabb,
+    /// Longest root-to-leaf path, in wide nodes (sizes the traversal stack).
+    pub depth: usize,
+}
+
+/// Statistics of a wide tree, with the SAH cost in the binary tree's units: a wide node
+/// costs one traversal step, a leaf one intersection per item.
+#[derive(Clone, Debug, Default)]
+pub struct WideStats {
+    pub nodes: usize,
+    pub leaves: usize,
+    pub depth: usize,
+    pub sah_cost: f64,
+    pub node_bytes: usize,
+    /// Mean number of used child slots per node.
+    pub fill: f64,
+}
+
+/// What closest-hit traversal does at a leaf: test items `first..first + count`, shorten
+/// `ray.t_max` on a hit and say whether there was one. A trait rather than a closure so that
+/// implementations can be `#[inline(always)]`: a call per leaf would spill the vector
+/// registers that hold the ray.
+pub trait ClosestLeaf {
+    fn test(&mut self, first: u32, count: u32, ray: &mut Ray) -> bool;
+}
+
+/// What any-hit traversal does at a leaf: true if anything blocks the ray.
+pub trait AnyLeaf {
+    fn test(&mut self, first: u32, count: u32, ray: &Ray) -> bool;
+}
+
+/// Closures work too (the scene's top level uses them; a call per instance is cheap there).
+pub struct FnLeaf<F>(pub F);
+
+impl<F: FnMut(u32, u32, &mut Ray) -> bool> ClosestLeaf for FnLeaf<F> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, ray: &mut Ray) -> bool {
+        (self.0)(first, count, ray)
+    }
+}
+
+impl<F: FnMut(u32, u32, &Ray) -> bool> AnyLeaf for FnLeaf<F> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, ray: &Ray) -> bool {
+        (self.0)(first, count, ray)
+    }
+}
+
+/// Traversal stack size in entries; a wide tree deeper than this allows is rejected at build.
+const STACK: usize = 512;
+
+impl<const W: usize> WideBvh<W> {
+    /// Collapses `bvh`. `leaf(first, count)` turns a binary leaf (a range of
+    /// `bvh.prim_indices`) into a leaf reference of the wide tree (it may repack the items).
+    pub fn collapse(bvh: &Bvh, mut leaf: impl FnMut(u32, u32) -> u32) -> WideBvh<W> {
+        assert!(W == 4 || W == 8);
+        let mut out = WideBvh { nodes: Vec::new(), root: EMPTY_CHILD, bounds: bvh.bounds(), depth: 0 };
+        if bvh.nodes.is_empty() {
+            return out;
+        }
+        let root = &bvh.nodes[0];
+        if root.is_leaf() {
+            out.root = leaf(root.first, root.count);
+            return out;
+        }
+        out.root = 0;
+        out.nodes.push(WideNode::EMPTY);
+        // (wide node index, binary node index, depth); children are appended breadth-first
+        // per node so that siblings' nodes sit together.
+        let mut work = vec![(0usize, 0u32, 1usize)];
+        while let Some((wi, bi, depth)) = work.pop() {
+            out.depth = out.depth.max(depth);
+            let mut kids: Vec<u32> = vec![bvh.nodes[bi as usize].first, bvh.nodes[bi as usize].first + 1];
+            while kids.len() < W {
+                // Open the interior child with the largest surface area.
+                let best = kids
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, &k)| !bvh.nodes[k as usize].is_leaf())
+                    .max_by(|a, b| area(&bvh.nodes[*a.1 as usize]).total_cmp(&area(&bvh.nodes[*b.1 as usize])));
+                let Some((i, &k)) = best else { break };
+                let first = bvh.nodes[k as usize].first;
+                kids[i] = first;
+                kids.push(first + 1);
+            }
+            let mut node = WideNode::<W>::EMPTY;
+            for (slot, &k) in kids.iter().enumerate() {
+                let bn = &bvh.nodes[k as usize];
+                let child = if bn.is_leaf() {
+                    leaf(bn.first, bn.count)
+                } else {
+                    let idx = out.nodes.len();
+                    out.nodes.push(WideNode::EMPTY);
+                    work.push((idx, k, depth + 1));
+                    idx as u32
+                };
+                node.set_child(slot, &bn.bounds, child);
+            }
+            out.nodes[wi] = node;
+        }
+        assert!(out.depth * (W - 1) + 1 < STACK, "BVH too deep for the wide traversal stack");
+        out
+    }
+
+    pub fn nodes(&self) -> &[WideNode<W>] {
+        &self.nodes
+    }
+
+    pub fn root(&self) -> u32 {
+        self.root
+    }
+
+    pub fn stats(&self, leaf_items: impl Fn(u32) -> f64) -> WideStats {
+        let mut s = WideStats {
+            depth: self.depth,
+            node_bytes: self.nodes.len() * std::mem::size_of::<WideNode<W>>(),
+            ..Default::default()
+        };
+        if self.root == EMPTY_CHILD {
+            return s;
+        }
+        let root_area = self.bounds.area().max(f32::MIN_POSITIVE) as f64;
+        if self.root & LEAF_BIT != 0 {
+            s.leaves = 1;
+            s.sah_cost = SAH_INTERSECT_COST as f64 * leaf_items(self.root);
+            return s;
+        }
+        s.sah_cost = SAH_TRAVERSAL_COST as f64; // the root, relative area 1
+        let mut used = 0usize;
+        for n in &self.nodes {
+            s.nodes += 1;
+            for i in 0..W {
+                let c = n.children[i];
+                if c == EMPTY_CHILD {
+                    continue;
+                }
+                used += 1;
+                let rel = n.child_bounds(i).area() as f64 / root_area;
+                if c & LEAF_BIT != 0 {
+                    s.leaves += 1;
+                    s.sah_cost += rel * SAH_INTERSECT_COST as f64 * leaf_items(c);
+                } else {
+                    s.sah_cost += rel * SAH_TRAVERSAL_COST as f64;
+                }
+            }
+        }
+        s.fill = used as f64 / s.nodes.max(1) as f64;
+        s
+    }
+
+    /// Closest-hit traversal; `leaf` tests a leaf's items (see [`ClosestLeaf`]).
+    ///
+    /// # Safety
+    /// `S` must be available on this CPU (see [`Isa`]).
+    #[inline(always)]
+    pub unsafe fn traverse<S: Isa>(&self, ray: &mut Ray, leaf: &mut impl ClosestLeaf) -> bool {
+        if self.root == EMPTY_CHILD {
+            return false;
+        }
+        let nr = NodeRay::new(ray);
+        let mut stack: [MaybeUninit<(u32, f32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
+        let mut sp = 0usize;
+        let mut cur = self.root;
+        let mut found = false;
+        loop {
+            if cur & LEAF_BIT == 0 {
+                // SAFETY: child references are built by `collapse` and always in range.
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                let mut dist = [0.0f32; W];
+                let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if mask == 0 {
+                        cur = node.children[first];
+                        continue;
+                    }
+                    // Several children hit: push them in order, farthest deepest, and go on
+                    // with the nearest.
+                    let base = sp;
+                    let mut push = |c: u32, d: f32, sp: &mut usize| {
+                        let mut j = *sp;
+                        // SAFETY: entries base..sp were written above, and `collapse`
+                        // rejects trees deep enough to overflow the stack.
+                        unsafe {
+                            while j > base && stack.get_unchecked(j - 1).assume_init().1 < d {
+                                *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
+                                j -= 1;
+                            }
+                            stack.get_unchecked_mut(j).write((c, d));
+                        }
+                        *sp += 1;
+                    };
+                    push(node.children[first], dist[first], &mut sp);
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        push(node.children[i], dist[i], &mut sp);
+                    }
+                    sp -= 1;
+                    // SAFETY: written by `push`.
+                    cur = unsafe { stack.get_unchecked(sp).assume_init() }.0;
+                    continue;
+                }
+            } else {
+                let (first, count) = leaf_range(cur);
+                found |= leaf.test(first, count, ray);
+            }
+            // Pop, skipping entries that lie beyond the closest hit so far.
+            loop {
+                if sp == 0 {
+                    return found;
+                }
+                sp -= 1;
+                // SAFETY: every entry below `sp` was written.
+                let (c, d) = unsafe { stack.get_unchecked(sp).assume_init() };
+                if d <= ray.t_max * FAR_SCALE {
+                    cur = c;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Any-hit traversal: true as soon as `leaf` reports a hit.
+    ///
+    /// # Safety
+    /// `S` must be available on this CPU (see [`Isa`]).
+    #[inline(always)]
+    pub unsafe fn occluded<S: Isa>(&self, ray: &Ray, leaf: &mut impl AnyLeaf) -> bool {
+        if self.root == EMPTY_CHILD {
+            return false;
+        }
+        let nr = NodeRay::new(ray);
+        let mut stack: [MaybeUninit<u32>; STACK] = [const { MaybeUninit::uninit() }; STACK];
+        let mut sp = 0usize;
+        let mut cur = self.root;
+        loop {
+            if cur & LEAF_BIT == 0 {
+                // SAFETY: child references are built by `collapse` and always in range.
+                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                let mut dist = [0.0f32; W];
+                let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
+                if mask != 0 {
+                    cur = node.children[mask.trailing_zeros() as usize];
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        // SAFETY: `collapse` rejects trees deep enough to overflow the stack.
+                        unsafe { stack.get_unchecked_mut(sp) }.write(node.children[mask.trailing_zeros() as usize]);
+                        sp += 1;
+                        mask &= mask - 1;
+                    }
+                    continue;
+                }
+            } else {
+                let (first, count) = leaf_range(cur);
+                if leaf.test(first, count, ray) {
+                    return true;
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            // SAFETY: every entry below `sp` was written.
+            cur = unsafe { stack.get_unchecked(sp).assume_init() };
+        }
+    }
+}
+
+fn area(n: &BvhNode) -> f32 {
+    n.bounds.area()
+}

@@ -1,0 +1,168 @@
+//! A wide BVH over triangles: the tree plus its leaves' triangles in blocks of four, and
+//! the run-time dispatch to the instruction set's kernels.
+
+use super::bvh::Bvh;
+#[cfg(target_arch = "x86_64")]
+use super::simd::{Avx2, Sse};
+use super::simd::{Isa, Scalar, SimdPath};
+use super::tri4::{Tri4, TriRay};
+use super::triangle::TriangleHit;
+use super::wide::{leaf_ref, WideBvh, WideStats, LEAF_BIT};
+use super::wide::{AnyLeaf, ClosestLeaf};
+use crate::math::{Ray, Vec3};
+use std::marker::PhantomData;
+
+/// Closest hit among a leaf's blocks of four.
+struct Closest<'a, S> {
+    blocks: &'a [Tri4],
+    tr: TriRay,
+    best: Option<(u32, TriangleHit)>,
+    isa: PhantomData<S>,
+}
+
+impl<S: Isa> ClosestLeaf for Closest<'_, S> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, r: &mut Ray) -> bool {
+        let mut hit = false;
+        // SAFETY: leaf ranges are built by `build` and always in range; `S` is available
+        // (the only callers are `intersect_generic`'s, which require it).
+        for b in unsafe { self.blocks.get_unchecked(first as usize..(first + count) as usize) } {
+            let h = unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) };
+            if let Some(lane) = h.nearest() {
+                r.t_max = h.t[lane];
+                self.best = Some((b.prim[lane], TriangleHit { t: h.t[lane], b1: h.b1[lane], b2: h.b2[lane] }));
+                hit = true;
+            }
+        }
+        hit
+    }
+}
+
+/// Any hit among a leaf's blocks of four.
+struct Any<'a, S> {
+    blocks: &'a [Tri4],
+    tr: TriRay,
+    isa: PhantomData<S>,
+}
+
+impl<S: Isa> AnyLeaf for Any<'_, S> {
+    #[inline(always)]
+    fn test(&mut self, first: u32, count: u32, r: &Ray) -> bool {
+        // SAFETY: as for `Closest`.
+        let blocks = unsafe { self.blocks.get_unchecked(first as usize..(first + count) as usize) };
+        blocks.iter().any(|b| unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) }.mask != 0)
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct TriangleWideBvh<const W: usize> {
+    /// Private: traversal relies on leaf ranges being in range of `blocks`.
+    tree: WideBvh<W>,
+    blocks: Vec<Tri4>,
+}
+
+impl<const W: usize> TriangleWideBvh<W> {
+    /// Collapses `bvh` (built over the triangles) and packs each leaf's triangles, in leaf
+    /// order, into blocks of four. `vertices(i)` gives triangle `i`'s corners.
+    pub fn build(bvh: &Bvh, vertices: impl Fn(u32) -> [Vec3; 3]) -> TriangleWideBvh<W> {
+        let mut blocks = Vec::with_capacity(bvh.prim_indices.len() / 3 + 1);
+        let tree = WideBvh::<W>::collapse(bvh, |first, count| {
+            let start = blocks.len();
+            let prims = &bvh.prim_indices[first as usize..(first + count) as usize];
+            for chunk in prims.chunks(4) {
+                let tris: Vec<(u32, [Vec3; 3])> = chunk.iter().map(|&p| (p, vertices(p))).collect();
+                blocks.push(Tri4::pack(&tris));
+            }
+            leaf_ref(start, blocks.len() - start)
+        });
+        TriangleWideBvh { tree, blocks }
+    }
+
+    pub fn tree(&self) -> &WideBvh<W> {
+        &self.tree
+    }
+
+    pub fn blocks(&self) -> &[Tri4] {
+        &self.blocks
+    }
+
+    pub fn stats(&self) -> WideStats {
+        // SAH in triangle tests: a block of four costs one test on the SIMD paths.
+        self.tree.stats(|leaf| super::wide::leaf_range(leaf).1 as f64)
+    }
+
+    pub fn bytes(&self) -> usize {
+        self.tree.nodes().len() * std::mem::size_of::<super::wide::WideNode<W>>()
+            + self.blocks.len() * std::mem::size_of::<Tri4>()
+    }
+
+    /// Closest hit with the given path: (triangle, hit); shortens `ray.t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &mut Ray, path: SimdPath) -> Option<(u32, TriangleHit)> {
+        // SAFETY (every arm): each path runs only where the CPU has it.
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 if path.is_available() => unsafe { self.intersect_avx2(ray) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 if path.is_available() => unsafe { self.intersect_avx512(ray) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.intersect_generic::<Sse>(ray) },
+            _ => unsafe { self.intersect_generic::<Scalar>(ray) },
+        }
+    }
+
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, path: SimdPath) -> bool {
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 if path.is_available() => unsafe { self.occluded_avx2(ray) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 if path.is_available() => unsafe { self.occluded_avx512(ray) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.occluded_generic::<Sse>(ray) },
+            _ => unsafe { self.occluded_generic::<Scalar>(ray) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn intersect_avx2(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
+        self.intersect_generic::<Avx2>(ray)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    unsafe fn intersect_avx512(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
+        self.intersect_generic::<Avx2>(ray)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn occluded_avx2(&self, ray: &Ray) -> bool {
+        self.occluded_generic::<Avx2>(ray)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    unsafe fn occluded_avx512(&self, ray: &Ray) -> bool {
+        self.occluded_generic::<Avx2>(ray)
+    }
+
+    #[inline(always)]
+    unsafe fn intersect_generic<S: Isa>(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
+        let mut leaf = Closest::<S> { blocks: &self.blocks, tr: TriRay::new(ray), best: None, isa: PhantomData };
+        self.tree.traverse::<S>(ray, &mut leaf);
+        leaf.best
+    }
+
+    #[inline(always)]
+    unsafe fn occluded_generic<S: Isa>(&self, ray: &Ray) -> bool {
+        let mut leaf = Any::<S> { blocks: &self.blocks, tr: TriRay::new(ray), isa: PhantomData };
+        self.tree.occluded::<S>(ray, &mut leaf)
+    }
+
+    /// Whether the tree is a single leaf (tiny meshes).
+    pub fn is_single_leaf(&self) -> bool {
+        self.tree.root() & LEAF_BIT != 0
+    }
+}
