@@ -6,6 +6,7 @@
 //!   subtracted: what remains is exactly proportional to 1/spp.
 //! - The emitting enclosure of the white-furnace test against its exact radiance 2: a bias
 //!   would show as an error that stops falling.
+//!
 //! The standard error of each level's mean squared error comes from the spread of the
 //! per-pixel squared errors; the delta method carries it to log RMSE and weighted least
 //! squares to the slope. Each level uses its own seed, so levels are independent.

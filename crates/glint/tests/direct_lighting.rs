@@ -5,6 +5,7 @@
 //!   polygon; the formula itself is checked against π L R²/(h² + R²));
 //! - sphere lights: E = π L (r/d)² at a point facing the centre;
 //! - point light: E = I cos θ / d²; directional light: E = E⊥ cos θ.
+//!
 //! Area lights are checked with every strategy, delta lights with those that sample lights.
 
 mod common;

@@ -78,7 +78,9 @@ fn assert_strategies_agree(scene: &Scene, settings: PathSettings, spp: u32) {
                             ra[r][c].mean, ra[r][c].se, rb[r][c].mean, rb[r][c].se
                         );
                     }
-                    if !(z.abs() <= k) {
+                    // Written so that a NaN fails too.
+                    let agrees = z.abs() <= k;
+                    if !agrees {
                         let what = if r == 0 { "image".to_string() } else { format!("block {}", r - 1) };
                         failures.push(format!(
                             "{sa:?} vs {sb:?}, {what}, channel {c}: {:.5} ± {:.5} vs {:.5} ± {:.5} (z = {z:.1}, limit {k:.2})",

@@ -3,6 +3,7 @@
 //!   Le reflect exactly what they receive, so every pixel is Le.
 //! - Inside a closed enclosure whose walls (and a box within) all emit Le and reflect with
 //!   albedo a, radiance is Le + a·L everywhere, so L = Le / (1 - a).
+//!
 //! Every path strategy and Russian roulette setting must agree with the exact value, each
 //! whole-image and 4×4-block mean within a critical number of standard errors.
 

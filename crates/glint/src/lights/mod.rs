@@ -310,3 +310,22 @@ pub fn scene_radius(bounds: &Aabb) -> f32 {
         (bounds.extent().length() * 0.5).max(1e-3)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::vec3;
+
+    #[test]
+    fn sphere_lights_are_sampled_only_from_the_side_they_light() {
+        let sphere = Sphere { center: Vec3::ZERO, radius: 1.0 };
+        let light = |inward| Light::Sphere { instance: 0, sphere, radiance: Rgb::WHITE, inward };
+        let (outside, inside) = (vec3(0.0, 0.0, 3.0), vec3(0.2, 0.1, 0.0));
+        for u in [[0.1, 0.2], [0.5, 0.5], [0.9, 0.7]] {
+            assert!(light(false).sample_li(outside, u).is_some());
+            assert!(light(false).sample_li(inside, u).is_none());
+            assert!(light(true).sample_li(outside, u).is_none());
+            assert!(light(true).sample_li(inside, u).is_some());
+        }
+    }
+}

@@ -6,6 +6,7 @@
 //!   fail or choose a delta lobe form one more cell, expected N (1 - ∫ pdf);
 //! - every non-delta sample's weight and pdf must equal eval/pdf and pdf recomputed from it;
 //! - the mean weight of the non-delta samples (an albedo estimate) must match ∫ eval dω.
+//!
 //! A new BSDF is tested by adding one `BsdfCase` to the list in `tests/bsdf_sampling.rs`.
 
 use super::stats::{chi2_survival, Estimate};
@@ -83,7 +84,8 @@ pub fn draw_samples(case: &BsdfCase, n: u64, seed: u64) -> Samples {
             continue;
         }
         let w = bs.weight.average() as f64;
-        if !bs.wi.is_finite() || (bs.wi.length() - 1.0).abs() > 1e-4 || !(w >= 0.0 && w.is_finite()) {
+        let valid_weight = w >= 0.0 && w.is_finite();
+        if !bs.wi.is_finite() || (bs.wi.length() - 1.0).abs() > 1e-4 || !valid_weight {
             s.malformed += 1;
             continue;
         }
@@ -110,6 +112,7 @@ impl Samples {
 
 /// Adaptive Simpson quadrature of a pair of functions on [a, b] (error judged on both).
 fn simpson(f: &dyn Fn(f64) -> [f64; 2], a: f64, b: f64, eps: f64, min_depth: u32, max_depth: u32) -> [f64; 2] {
+    #[allow(clippy::too_many_arguments)] // the recursion carries the interval's samples
     fn rec(
         f: &dyn Fn(f64) -> [f64; 2],
         a: f64,

@@ -188,7 +188,9 @@ pub fn check_constant_image(label: &str, out: &RenderOutput, exact: f64, block: 
         (whole.mean - exact) / whole.se
     );
     let mut check = |what: String, e: Estimate| {
-        if !((e.mean - exact).abs() <= k * e.se) {
+        // Written so that a NaN fails too.
+        let within = (e.mean - exact).abs() <= k * e.se;
+        if !within {
             failures.push(format!(
                 "{label}: {what} mean {:.5} ± {:.5}, exact {exact:.5} ({:.1} standard errors, limit {k:.2})",
                 e.mean,
