@@ -25,6 +25,18 @@ pub use phong::Phong;
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
 
+impl BsdfSample {
+    /// A non-delta sample of direction `wi` for a BSDF whose `eval` and `pdf` give `value`
+    /// and `pdf` there; `None` when the direction is below the surface or has no density.
+    #[inline]
+    pub fn non_delta(wi: Vec3, value: Rgb, pdf: f32) -> Option<BsdfSample> {
+        if wi.z <= 0.0 || !(pdf > 0.0) {
+            return None;
+        }
+        Some(BsdfSample { wi, weight: value / pdf, pdf, delta: false })
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
     pub wi: Vec3,
@@ -162,14 +174,7 @@ impl Bsdf {
                 }
                 let h = dist.sample_wm(wo, u);
                 let wi = (h * (2.0 * wo.dot(h)) - wo).normalize();
-                if wi.z <= 0.0 {
-                    return None;
-                }
-                let pdf = self.pdf(wo, wi);
-                if pdf <= 0.0 {
-                    return None;
-                }
-                Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false })
+                BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
             }
             Bsdf::Dielectric { eta, reflect, transmit } => {
                 let fr = fresnel_dielectric(wo.z, *eta);
@@ -212,4 +217,3 @@ impl Bsdf {
         }
     }
 }
-

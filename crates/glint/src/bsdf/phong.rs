@@ -64,13 +64,6 @@ impl Phong {
         } else {
             warp::cosine_hemisphere(u)
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false })
+        BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
     }
 }

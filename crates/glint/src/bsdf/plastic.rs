@@ -197,14 +197,7 @@ impl PlasticParams {
     }
 
     fn finish(&self, wo: Vec3, wi: Vec3) -> Option<BsdfSample> {
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false })
+        BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
     }
 }
 

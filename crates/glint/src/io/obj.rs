@@ -54,6 +54,17 @@ fn parse_floats<const N: usize>(path: &Path, line: usize, parts: &[&str], what: 
     Ok(out)
 }
 
+/// The statements of an OBJ or MTL file: (line number, keyword, arguments), comments and
+/// blank lines skipped.
+fn statements(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
+    text.lines().enumerate().filter_map(|(i, raw)| {
+        let l = raw.split('#').next().unwrap_or("").trim();
+        let mut it = l.split_whitespace();
+        let key = it.next()?;
+        Some((i + 1, key, it.collect()))
+    })
+}
+
 pub fn read_obj(path: &Path) -> Result<ObjFile, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     parse_obj(&text, path)
@@ -76,15 +87,7 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjFile, String> {
     let mut gn: Vec<Vec<Vec3>> = Vec::new();
     let mut gt: Vec<Vec<[f32; 2]>> = Vec::new();
 
-    for (lineno, raw) in text.lines().enumerate() {
-        let line = lineno + 1;
-        let l = raw.split('#').next().unwrap_or("").trim();
-        if l.is_empty() {
-            continue;
-        }
-        let mut it = l.split_whitespace();
-        let key = it.next().unwrap_or("");
-        let rest: Vec<&str> = it.collect();
+    for (line, key, rest) in statements(text) {
         match key {
             "v" => positions.push(Vec3::from_array(parse_floats::<3>(path, line, &rest, "v")?)),
             "vn" => normals.push(Vec3::from_array(parse_floats::<3>(path, line, &rest, "vn")?)),
@@ -207,15 +210,7 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjFile, String> {
 pub fn read_mtl(path: &Path) -> Result<Vec<MtlMaterial>, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut out: Vec<MtlMaterial> = Vec::new();
-    for (lineno, raw) in text.lines().enumerate() {
-        let line = lineno + 1;
-        let l = raw.split('#').next().unwrap_or("").trim();
-        if l.is_empty() {
-            continue;
-        }
-        let mut it = l.split_whitespace();
-        let key = it.next().unwrap_or("");
-        let rest: Vec<&str> = it.collect();
+    for (line, key, rest) in statements(&text) {
         if key == "newmtl" {
             out.push(MtlMaterial { name: rest.join(" "), ni: 1.5, dissolve: 1.0, ..Default::default() });
             continue;

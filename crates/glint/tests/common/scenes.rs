@@ -7,8 +7,8 @@ use glint::geometry::{cube_mesh, quad_mesh};
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::materials::{Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
-use glint::sampling::SamplerKind;
 use glint::render::{render, PixelFilter, RenderOutput, RenderSettings, Silent};
+use glint::sampling::SamplerKind;
 use glint::scene::{Emission, LightSelection, Scene, SceneBuilder};
 use std::sync::Arc;
 
@@ -22,7 +22,14 @@ pub fn camera(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, width: u32, h
 pub fn settings(spp: u32, seed: u64) -> RenderSettings {
     // Independent samples: the tolerances below are derived from the variance of a mean of
     // independent samples (the Sobol default is checked against this in sampler_unbiased.rs).
-    RenderSettings { spp, seed, filter: PixelFilter::Box, sampler: SamplerKind::Independent, variance: true, tile_size: 4 }
+    RenderSettings {
+        spp,
+        seed,
+        filter: PixelFilter::Box,
+        sampler: SamplerKind::Independent,
+        variance: true,
+        tile_size: 4,
+    }
 }
 
 pub fn path(strategy: Strategy) -> Integrator {
