@@ -220,14 +220,16 @@ int main(int argc, char** argv) {
     fclose(f);
   }
   double sah_binned = generic_sah(dev, tris, ntri, false);
-  double sah_spatial = generic_sah(dev, tris, ntri, true);
+  // The spatial-split build needs twice the references and minutes on 10M triangles.
+  double sah_spatial = ntri <= 2000000 ? generic_sah(dev, tris, ntri, true) : NAN;
   printf("{\"engine\":\"embree %d.%d.%d\",\"triangles\":%zu,\"rays\":%zu,\"threads\":1,\"build_ms\":%.3f,"
          "\"closest_mrays_per_s\":%.4f,\"occluded_mrays_per_s\":%.4f,\"hit_fraction\":%.6f,"
          "\"occluded_fraction\":%.6f,\"bvh_bytes\":%lld,\"bytes_per_triangle\":%.2f,"
-         "\"sah_cost\":%.4f,\"sah_cost_spatial\":%.4f}\n",
+         "\"sah_cost\":%.4f,\"sah_cost_spatial\":%s}\n",
          RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, ntri, nray, build_s * 1e3,
          nray / closest_s / 1e6, nray / occluded_s / 1e6, (double)hit_count / nray, (double)occ_count / nray,
-         bytes, (double)bytes / ntri, sah_binned, sah_spatial);
+         bytes, (double)bytes / ntri, sah_binned,
+         std::isnan(sah_spatial) ? "null" : std::to_string(sah_spatial).c_str());
   rtcReleaseScene(scene);
   rtcReleaseDevice(dev);
   return 0;

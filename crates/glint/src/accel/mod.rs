@@ -2,6 +2,7 @@
 //! from it, and triangle intersection.
 
 mod bvh;
+mod huge_pages;
 pub mod simd;
 mod top_level;
 pub mod tri4;

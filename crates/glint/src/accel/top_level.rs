@@ -1,25 +1,96 @@
 //! The scene's top level: a BVH over instances, binary (the reference) and 8-wide (what
 //! traversal uses). Leaves are ranges of instance numbers; the caller's closure intersects
 //! one instance (itself tracing that mesh's own wide BVH).
+//!
+//! Mesh instances without a transform (baked into world space, the common case) are not in
+//! that tree: their triangles are merged into one flat wide BVH, so that a ray pays for one
+//! traversal instead of one per overlapping mesh (the Cornell box's six meshes all overlap
+//! the room). Hits in it map back to (instance, triangle) through prefix sums.
 
-use super::bvh::{Bvh, BvhSplit, BvhStats};
+use super::bvh::{BuildOptions, Bvh, BvhSplit, BvhStats};
 #[cfg(target_arch = "x86_64")]
 use super::simd::{Avx2, Sse};
 use super::simd::{Isa, Scalar, SimdPath};
+use super::triangle::TriangleHit;
 use super::wide::{leaf_ref, FnLeaf, WideBvh};
+use super::wide_mesh::TriangleWideBvh;
+use crate::geometry::TriangleMesh;
 use crate::math::{Aabb, Ray};
 
 #[derive(Clone, Debug, Default)]
 pub struct TopLevelBvh {
+    /// Over the instances of `rest` (its primitive `i` is instance `rest[i]`).
     pub binary: Bvh,
     wide: WideBvh<8>,
+    rest: Vec<u32>,
+    /// All triangles of the flattened instances; triangle `g` belongs to instance
+    /// `flat_instances[k]` where `flat_offsets[k] <= g < flat_offsets[k + 1]`.
+    flat: Option<TriangleWideBvh<8>>,
+    flat_instances: Vec<u32>,
+    flat_offsets: Vec<u32>,
 }
 
 impl TopLevelBvh {
+    /// A tree over every instance (no flattening).
     pub fn build(bounds: &[Aabb], split: BvhSplit) -> TopLevelBvh {
-        let binary = Bvh::build(bounds, split);
+        TopLevelBvh::build_flattening(bounds, split, &[])
+    }
+
+    /// A tree over the instances not in `flat`, plus one merged BVH over the triangles of the
+    /// instances in `flat` (instance number, its mesh in world space).
+    pub fn build_flattening(bounds: &[Aabb], split: BvhSplit, flat: &[(u32, &TriangleMesh)]) -> TopLevelBvh {
+        let in_flat: std::collections::HashSet<u32> = flat.iter().map(|f| f.0).collect();
+        let rest: Vec<u32> = (0..bounds.len() as u32).filter(|i| !in_flat.contains(i)).collect();
+        let rest_bounds: Vec<Aabb> = rest.iter().map(|&i| bounds[i as usize]).collect();
+        let binary = Bvh::build(&rest_bounds, split);
         let wide = WideBvh::collapse(&binary, |first, count| leaf_ref(first as usize, count as usize));
-        TopLevelBvh { binary, wide }
+        let mut top = TopLevelBvh { binary, wide, rest, ..Default::default() };
+        if flat.is_empty() {
+            return top;
+        }
+        let mut offsets = vec![0u32];
+        for (_, m) in flat {
+            offsets.push(offsets.last().unwrap() + m.indices.len() as u32);
+        }
+        let locate = |g: u32| -> (usize, usize) {
+            let k = offsets.partition_point(|&o| o <= g) - 1;
+            (k, (g - offsets[k]) as usize)
+        };
+        let tri_bounds: Vec<Aabb> = (0..*offsets.last().unwrap())
+            .map(|g| {
+                let (k, t) = locate(g);
+                let [a, b, c] = flat[k].1.vertices(t);
+                // Zero-area triangles cannot be hit: keep them out of the SAH's way.
+                if (b - a).cross(c - a).length_squared() == 0.0 {
+                    Aabb::EMPTY
+                } else {
+                    Aabb::from_points(&[a, b, c])
+                }
+            })
+            .collect();
+        let bvh = Bvh::build_with(&tri_bounds, split, BuildOptions::WIDE);
+        top.flat = Some(TriangleWideBvh::build(&bvh, |g| {
+            let (k, t) = locate(g);
+            flat[k].1.vertices(t)
+        }));
+        top.flat_instances = flat.iter().map(|f| f.0).collect();
+        top.flat_offsets = offsets;
+        top
+    }
+
+    /// Closest hit among the flattened instances: (instance, triangle, hit); shortens
+    /// `ray.t_max`.
+    #[inline]
+    pub fn intersect_flat(&self, ray: &mut Ray) -> Option<(u32, u32, TriangleHit)> {
+        let (g, h) = self.flat.as_ref()?.intersect(ray, SimdPath::detect())?;
+        let k = self.flat_offsets.partition_point(|&o| o <= g) - 1;
+        Some((self.flat_instances[k], g - self.flat_offsets[k], h))
+    }
+
+    /// Whether anything among the flattened instances blocks the ray.
+    #[inline]
+    pub fn occluded_flat(&self, ray: &Ray) -> bool {
+        self.flat.as_ref().is_some_and(|f| f.occluded(ray, SimdPath::detect()))
     }
 
     pub fn stats(&self) -> BvhStats {
@@ -71,10 +142,11 @@ impl TopLevelBvh {
     #[inline(always)]
     unsafe fn traverse_generic<S: Isa, F: FnMut(u32, &mut Ray) -> bool>(&self, ray: &mut Ray, mut hit_prim: F) -> bool {
         let prims = &self.binary.prim_indices;
+        let rest = &self.rest;
         let mut leaf = FnLeaf(|first: u32, count: u32, r: &mut Ray| {
             let mut hit = false;
             for &p in &prims[first as usize..(first + count) as usize] {
-                hit |= hit_prim(p, r);
+                hit |= hit_prim(rest[p as usize], r);
             }
             hit
         });
@@ -84,8 +156,9 @@ impl TopLevelBvh {
     #[inline(always)]
     unsafe fn occluded_generic<S: Isa, F: FnMut(u32, &Ray) -> bool>(&self, ray: &Ray, mut hit_prim: F) -> bool {
         let prims = &self.binary.prim_indices;
+        let rest = &self.rest;
         let mut leaf = FnLeaf(|first: u32, count: u32, r: &Ray| {
-            prims[first as usize..(first + count) as usize].iter().any(|&p| hit_prim(p, r))
+            prims[first as usize..(first + count) as usize].iter().any(|&p| hit_prim(rest[p as usize], r))
         });
         self.wide.occluded::<S>(ray, &mut leaf)
     }

@@ -209,6 +209,7 @@ impl<const W: usize> WideBvh<W> {
             out.nodes[wi] = node;
         }
         assert!(out.depth * (W - 1) + 1 < STACK, "BVH too deep for the wide traversal stack");
+        out.nodes = super::huge_pages::on_huge_pages(out.nodes);
         out
     }
 

@@ -75,7 +75,7 @@ impl<const W: usize> TriangleWideBvh<W> {
             }
             leaf_ref(start, blocks.len() - start)
         });
-        TriangleWideBvh { tree, blocks }
+        TriangleWideBvh { tree, blocks: super::huge_pages::on_huge_pages(blocks) }
     }
 
     pub fn tree(&self) -> &WideBvh<W> {

@@ -103,7 +103,17 @@ impl Scene {
     /// scene builder after all instances and lights are in place.
     pub fn finish(&mut self, selection: LightSelection) {
         let boxes: Vec<Aabb> = self.instances.iter().map(|i| i.bounds).collect();
-        self.top = TopLevelBvh::build(&boxes, self.bvh_split);
+        // Untransformed mesh instances go into one merged triangle BVH (see TopLevelBvh).
+        let flat: Vec<(u32, &TriangleMesh)> = self
+            .instances
+            .iter()
+            .enumerate()
+            .filter_map(|(i, inst)| match (inst.shape, &inst.to_world) {
+                (ShapeRef::Mesh(m), None) => Some((i as u32, &*self.meshes[m as usize])),
+                _ => None,
+            })
+            .collect();
+        self.top = TopLevelBvh::build_flattening(&boxes, self.bvh_split, &flat);
         self.bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
         self.set_light_selection(selection);
     }
@@ -133,7 +143,13 @@ impl Scene {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut r = *ray;
-        let mut best: Option<Hit> = None;
+        let mut best: Option<Hit> = self.top.intersect_flat(&mut r).map(|(instance, prim, h)| Hit {
+            t: h.t,
+            instance,
+            prim,
+            b1: h.b1,
+            b2: h.b2,
+        });
         self.top.traverse(&mut r, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
             if let Some(h) = self.intersect_instance(inst, r) {
@@ -167,6 +183,9 @@ impl Scene {
     /// True when anything blocks the ray within its interval.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        if self.top.occluded_flat(ray) {
+            return true;
+        }
         self.top.occluded(ray, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
             match inst.shape {

@@ -62,12 +62,17 @@ impl SimdPath {
     /// The path traversal uses unless told otherwise: `GLINT_SIMD` (scalar, sse, avx2,
     /// avx512) if set and available, else AVX2 when present. AVX-512 is not the default: on
     /// the machines measured it was no faster (see BENCHMARKS.md) and it can lower clocks.
+    #[inline]
     pub fn detect() -> SimdPath {
-        static CHOSEN: AtomicU8 = AtomicU8::new(u8::MAX);
-        let c = CHOSEN.load(Ordering::Relaxed);
-        if c != u8::MAX {
-            return SimdPath::ALL[c as usize];
+        // Called per ray: a relaxed load once the choice is made.
+        match CHOSEN.load(Ordering::Relaxed) {
+            u8::MAX => SimdPath::choose(),
+            c => SimdPath::ALL[c as usize & 3],
         }
+    }
+
+    #[cold]
+    fn choose() -> SimdPath {
         let from_env = std::env::var("GLINT_SIMD").ok().and_then(|s| s.parse::<SimdPath>().ok());
         let p = match from_env {
             Some(p) if p.is_available() => p,
@@ -77,6 +82,8 @@ impl SimdPath {
         p
     }
 }
+
+static CHOSEN: AtomicU8 = AtomicU8::new(u8::MAX);
 
 impl std::str::FromStr for SimdPath {
     type Err = String;
