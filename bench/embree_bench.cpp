@@ -5,7 +5,9 @@
 // wide build uses (leaves of at most 4), once without spatial splits (binned SAH, like
 // glint) and once with them (HIGH quality), scored with glint's formula.
 //
-// usage: embree_bench TRIS.bin RAYS.bin [--hits OUT.bin] [--repeat N]
+// usage: embree_bench TRIS.bin RAYS.bin [--hits OUT.bin] [--repeat N] [--quality high|medium] [--robust]
+// (--quality medium: Embree's binned SAH build without spatial splits; --robust: Embree's
+// watertight mode, RTC_SCENE_FLAG_ROBUST, the guarantee glint's triangle test always gives)
 #include <embree3/rtcore.h>
 #include <algorithm>
 #include <atomic>
@@ -138,12 +140,16 @@ static double generic_sah(RTCDevice dev, const float* tris, size_t n, bool spati
 }
 
 int main(int argc, char** argv) {
-  if (argc < 3) { fprintf(stderr, "usage: embree_bench TRIS.bin RAYS.bin [--hits OUT.bin] [--repeat N]\n"); return 2; }
+  if (argc < 3) { fprintf(stderr, "usage: embree_bench TRIS.bin RAYS.bin [--hits OUT.bin] [--repeat N] [--quality high|medium] [--robust]\n"); return 2; }
   const char* hits_path = nullptr;
   int repeat = 5;
+  RTCBuildQuality quality = RTC_BUILD_QUALITY_HIGH;
+  bool robust = false;
   for (int i = 3; i < argc; i++) {
     if (!strcmp(argv[i], "--hits") && i + 1 < argc) hits_path = argv[++i];
     else if (!strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--robust")) robust = true;
+    else if (!strcmp(argv[i], "--quality") && i + 1 < argc) quality = strcmp(argv[++i], "medium") ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
   }
   std::vector<char> tri_data = read_file(argv[1]);
   std::vector<char> ray_data = read_file(argv[2]);
@@ -162,9 +168,10 @@ int main(int argc, char** argv) {
   for (int b = 0; b < 3; b++) {
     if (scene) rtcReleaseScene(scene);
     scene = rtcNewScene(dev);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(scene, quality);
+    if (robust) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    rtcSetGeometryBuildQuality(g, quality);
     float* v = (float*)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, ntri * 3);
     unsigned* idx = (unsigned*)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, ntri);
     memcpy(v, tris, ntri * 36);

@@ -11,6 +11,7 @@
 //! level) that the caller's closure tests.
 
 use super::bvh::{Bvh, BvhNode, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
+use super::huge_pages::PageBuf;
 use super::simd::Isa;
 use crate::math::{Aabb, Ray};
 use std::mem::MaybeUninit;
@@ -73,11 +74,15 @@ impl<const W: usize> WideNode<W> {
 
 /// Per-ray constants of the box test. `near[a]` is the row of `bounds` that the ray enters
 /// through on axis `a` (min when the direction is positive), `far[a]` the one it leaves by,
-/// so the test needs no min/max per slab.
+/// so the test needs no min/max per slab. Exit distances use `inv_far`, the reciprocal
+/// widened by [`FAR_SCALE`] once per ray, so that the widening is not one more dependent
+/// multiply on every node (traversal is a chain of dependent node tests: their latency is
+/// what it costs).
 #[derive(Clone, Copy, Debug)]
 pub struct NodeRay {
     pub o: [f32; 3],
     pub inv: [f32; 3],
+    pub inv_far: [f32; 3],
     pub near: [usize; 3],
     pub far: [usize; 3],
     pub t_min: f32,
@@ -91,6 +96,7 @@ impl NodeRay {
         NodeRay {
             o: ray.origin.to_array(),
             inv,
+            inv_far: inv.map(|x| x * FAR_SCALE),
             near: [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)],
             far: [3 - 3 * neg(0), 4 - 3 * neg(1), 5 - 3 * neg(2)],
             t_min: ray.t_min,
@@ -99,13 +105,15 @@ impl NodeRay {
 }
 
 /// Widening of the far distance that keeps boxes touched exactly by a ray (flat boxes,
-/// rounding) from being missed; the same factor as the binary BVH's slab test.
+/// rounding) from being missed; the same factor as the binary BVH's slab test. It widens
+/// the exit distances through `NodeRay::inv_far` and the ray's `t_max`, which the node
+/// kernels receive already widened.
 pub const FAR_SCALE: f32 = 1.000_000_24;
 
 #[derive(Clone, Debug, Default)]
 pub struct WideBvh<const W: usize> {
     /// Private: traversal relies on every child reference being in range.
-    nodes: Vec<WideNode<W>>,
+    nodes: PageBuf<WideNode<W>>,
     /// The root: a node index, or a leaf when the whole tree is one leaf.
     root: u32,
     pub bounds: Aabb,
@@ -164,7 +172,7 @@ impl<const W: usize> WideBvh<W> {
     /// `bvh.prim_indices`) into a leaf reference of the wide tree (it may repack the items).
     pub fn collapse(bvh: &Bvh, mut leaf: impl FnMut(u32, u32) -> u32) -> WideBvh<W> {
         assert!(W == 4 || W == 8);
-        let mut out = WideBvh { nodes: Vec::new(), root: EMPTY_CHILD, bounds: bvh.bounds(), depth: 0 };
+        let mut out = WideBvh { nodes: PageBuf::default(), root: EMPTY_CHILD, bounds: bvh.bounds(), depth: 0 };
         if bvh.nodes.is_empty() {
             return out;
         }
@@ -174,7 +182,7 @@ impl<const W: usize> WideBvh<W> {
             return out;
         }
         out.root = 0;
-        out.nodes.push(WideNode::EMPTY);
+        let mut nodes = vec![WideNode::EMPTY];
         // (wide node index, binary node index, depth); children are appended breadth-first
         // per node so that siblings' nodes sit together.
         let mut work = vec![(0usize, 0u32, 1usize)];
@@ -199,17 +207,17 @@ impl<const W: usize> WideBvh<W> {
                 let child = if bn.is_leaf() {
                     leaf(bn.first, bn.count)
                 } else {
-                    let idx = out.nodes.len();
-                    out.nodes.push(WideNode::EMPTY);
+                    let idx = nodes.len();
+                    nodes.push(WideNode::EMPTY);
                     work.push((idx, k, depth + 1));
                     idx as u32
                 };
                 node.set_child(slot, &bn.bounds, child);
             }
-            out.nodes[wi] = node;
+            nodes[wi] = node;
         }
         assert!(out.depth * (W - 1) + 1 < STACK, "BVH too deep for the wide traversal stack");
-        out.nodes = super::huge_pages::on_huge_pages(out.nodes);
+        out.nodes = PageBuf::new(nodes);
         out
     }
 
@@ -238,7 +246,7 @@ impl<const W: usize> WideBvh<W> {
         }
         s.sah_cost = SAH_TRAVERSAL_COST as f64; // the root, relative area 1
         let mut used = 0usize;
-        for n in &self.nodes {
+        for n in self.nodes.iter() {
             s.nodes += 1;
             for i in 0..W {
                 let c = n.children[i];
@@ -277,8 +285,9 @@ impl<const W: usize> WideBvh<W> {
             if cur & LEAF_BIT == 0 {
                 // SAFETY: child references are built by `collapse` and always in range.
                 let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                prefetch(node.children.as_ptr());
                 let mut dist = [0.0f32; W];
-                let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
+                let mut mask = S::node(node, &nr, ray.t_max * FAR_SCALE, &mut dist);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -350,8 +359,9 @@ impl<const W: usize> WideBvh<W> {
             if cur & LEAF_BIT == 0 {
                 // SAFETY: child references are built by `collapse` and always in range.
                 let node = unsafe { self.nodes.get_unchecked(cur as usize) };
+                prefetch(node.children.as_ptr());
                 let mut dist = [0.0f32; W];
-                let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
+                let mut mask = S::node(node, &nr, ray.t_max * FAR_SCALE, &mut dist);
                 if mask != 0 {
                     cur = node.children[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
@@ -377,6 +387,20 @@ impl<const W: usize> WideBvh<W> {
             cur = unsafe { stack.get_unchecked(sp).assume_init() };
         }
     }
+}
+
+/// Starts loading the cache line that holds a node's child references together with its
+/// bounds: the reference is needed only after the box test, and without this its load
+/// (another cache miss on incoherent rays) waits for the test's result.
+#[inline(always)]
+fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch never faults, whatever the address.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p as *const i8)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }
 
 fn area(n: &BvhNode) -> f32 {

@@ -2,6 +2,7 @@
 //! the run-time dispatch to the instruction set's kernels.
 
 use super::bvh::Bvh;
+use super::huge_pages::PageBuf;
 #[cfg(target_arch = "x86_64")]
 use super::simd::{Avx2, Sse};
 use super::simd::{Isa, Scalar, SimdPath};
@@ -50,7 +51,14 @@ impl<S: Isa> AnyLeaf for Any<'_, S> {
     fn test(&mut self, first: u32, count: u32, r: &Ray) -> bool {
         // SAFETY: as for `Closest`.
         let blocks = unsafe { self.blocks.get_unchecked(first as usize..(first + count) as usize) };
-        blocks.iter().any(|b| unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) }.mask != 0)
+        // A plain loop: `Iter::any` was compiled as a separate function, called per leaf
+        // from outside the AVX2 entry point (perf showed it apart from the traversal).
+        for b in blocks {
+            if unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) }.mask != 0 {
+                return true;
+            }
+        }
+        false
     }
 }
 
@@ -58,7 +66,7 @@ impl<S: Isa> AnyLeaf for Any<'_, S> {
 pub struct TriangleWideBvh<const W: usize> {
     /// Private: traversal relies on leaf ranges being in range of `blocks`.
     tree: WideBvh<W>,
-    blocks: Vec<Tri4>,
+    blocks: PageBuf<Tri4>,
 }
 
 impl<const W: usize> TriangleWideBvh<W> {
@@ -75,7 +83,7 @@ impl<const W: usize> TriangleWideBvh<W> {
             }
             leaf_ref(start, blocks.len() - start)
         });
-        TriangleWideBvh { tree, blocks: super::huge_pages::on_huge_pages(blocks) }
+        TriangleWideBvh { tree, blocks: PageBuf::new(blocks) }
     }
 
     pub fn tree(&self) -> &WideBvh<W> {
