@@ -10,6 +10,8 @@
 use super::{fresnel_dielectric, reflect_local, BsdfSample, Microfacet};
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
 
 #[derive(Clone, Copy, Debug)]
 pub struct PlasticParams {
@@ -23,7 +25,9 @@ pub struct PlasticParams {
     pub fdr_internal: f32,
     /// Rough coatings: energy transmitted through the interface against the cosine of the
     /// direction (TRANSMITTANCE_RES points over [0, 1]); `None` for smooth ones (1 - F).
-    pub transmittance: Option<[f32; TRANSMITTANCE_RES]>,
+    /// Interned (see `rough_coating_tables`), so that the BSDF stays small: it is built by
+    /// value at every hit.
+    pub transmittance: Option<&'static [f32; TRANSMITTANCE_RES]>,
 }
 
 pub const TRANSMITTANCE_RES: usize = 64;
@@ -70,19 +74,35 @@ pub fn diffuse_fresnel_reflectance(eta: f32) -> f32 {
     }
 }
 
+/// The internal diffuse reflectance and the transmittance table of a rough coating, computed
+/// once per distinct (interface, eta) and kept for the life of the process: a scene has a
+/// handful of distinct coatings, and a `'static` table keeps `PlasticParams` `Copy`.
+fn rough_coating_tables(d: &Microfacet, eta: f32) -> (f32, &'static [f32; TRANSMITTANCE_RES]) {
+    type Cache = HashMap<(String, u32), (f32, &'static [f32; TRANSMITTANCE_RES])>;
+    static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
+    let key = (format!("{d:?}"), eta.to_bits());
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(&hit) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return hit;
+    }
+    let mut table = [0.0f32; TRANSMITTANCE_RES];
+    let mut internal = 0.0f32;
+    for (i, t) in table.iter_mut().enumerate() {
+        let mu = (i as f32 / (TRANSMITTANCE_RES - 1) as f32).max(1e-6);
+        *t = rough_interface_albedo(d, eta, mu).1;
+        internal += rough_interface_albedo(d, 1.0 / eta, mu).0 * mu;
+    }
+    let entry = (2.0 * internal / TRANSMITTANCE_RES as f32, &*Box::leak(Box::new(table)));
+    *cache.lock().unwrap_or_else(|e| e.into_inner()).entry(key).or_insert(entry)
+}
+
 impl PlasticParams {
     pub fn new(diffuse: Rgb, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> PlasticParams {
         let (fdr_internal, transmittance) = match &dist {
             None => (diffuse_fresnel_reflectance(1.0 / eta), None),
             Some(d) => {
-                let mut table = [0.0f32; TRANSMITTANCE_RES];
-                let mut internal = 0.0f32;
-                for (i, t) in table.iter_mut().enumerate() {
-                    let mu = (i as f32 / (TRANSMITTANCE_RES - 1) as f32).max(1e-6);
-                    *t = rough_interface_albedo(d, eta, mu).1;
-                    internal += rough_interface_albedo(d, 1.0 / eta, mu).0 * mu;
-                }
-                (2.0 * internal / TRANSMITTANCE_RES as f32, Some(table))
+                let (internal, table) = rough_coating_tables(d, eta);
+                (internal, Some(table))
             }
         };
         PlasticParams { diffuse, specular, eta, dist, fdr_internal, transmittance }
