@@ -13,14 +13,19 @@ use std::ptr::NonNull;
 const THRESHOLD: usize = 1 << 20;
 const HUGE_PAGE: usize = 2 << 20;
 
-/// An immutable array, on huge pages when it is large.
+/// An immutable array, on huge pages when it is large. Reading it is a plain pointer and
+/// length (no branch on where it lives): traversal reads it on every node.
 pub struct PageBuf<T: Copy> {
+    ptr: NonNull<T>,
+    len: usize,
     storage: Storage<T>,
 }
 
 enum Storage<T> {
-    Small(Vec<T>),
-    Huge { ptr: NonNull<T>, len: usize, layout: Layout },
+    /// `ptr` points into this vector's buffer, which does not move with the vector; it is
+    /// held only to keep the buffer alive.
+    Small { _owner: Vec<T> },
+    Huge(Layout),
 }
 
 // SAFETY: `PageBuf` owns its elements like a `Vec` does and never shares the allocation.
@@ -32,15 +37,15 @@ impl<T: Copy> PageBuf<T> {
     pub fn new(v: Vec<T>) -> PageBuf<T> {
         let bytes = std::mem::size_of_val(v.as_slice());
         if bytes < THRESHOLD || !cfg!(target_os = "linux") || std::mem::align_of::<T>() > HUGE_PAGE {
-            return PageBuf { storage: Storage::Small(v) };
+            return PageBuf::small(v);
         }
         let Ok(layout) = Layout::from_size_align(bytes.div_ceil(HUGE_PAGE) * HUGE_PAGE, HUGE_PAGE) else {
-            return PageBuf { storage: Storage::Small(v) };
+            return PageBuf::small(v);
         };
         // SAFETY: the layout has a non-zero size (bytes >= THRESHOLD).
         let raw = unsafe { std::alloc::alloc(layout) };
         let Some(ptr) = NonNull::new(raw as *mut T) else {
-            return PageBuf { storage: Storage::Small(v) };
+            return PageBuf::small(v);
         };
         #[cfg(target_os = "linux")]
         // SAFETY: the range is this allocation; madvise only changes how the kernel backs it,
@@ -52,32 +57,37 @@ impl<T: Copy> PageBuf<T> {
         // SAFETY: the allocation holds `v.len()` elements, is aligned for `T` (2 MiB is a
         // multiple of any smaller power-of-two alignment), and `T: Copy` needs no drop.
         unsafe { std::ptr::copy_nonoverlapping(v.as_ptr(), ptr.as_ptr(), v.len()) };
-        PageBuf { storage: Storage::Huge { ptr, len: v.len(), layout } }
+        PageBuf { ptr, len: v.len(), storage: Storage::Huge(layout) }
+    }
+
+    fn small(v: Vec<T>) -> PageBuf<T> {
+        // SAFETY: a vector's pointer is never null (dangling but aligned when empty).
+        let ptr = unsafe { NonNull::new_unchecked(v.as_ptr() as *mut T) };
+        PageBuf { ptr, len: v.len(), storage: Storage::Small { _owner: v } }
     }
 
     /// Whether the array was placed on huge-page-advised memory.
     #[cfg(test)]
     fn is_huge(&self) -> bool {
-        matches!(self.storage, Storage::Huge { .. })
+        matches!(self.storage, Storage::Huge(_))
     }
 }
 
 impl<T: Copy> Deref for PageBuf<T> {
     type Target = [T];
+    #[inline(always)]
     fn deref(&self) -> &[T] {
-        match &self.storage {
-            Storage::Small(v) => v,
-            // SAFETY: `ptr` holds `len` initialised elements for as long as `self` lives.
-            Storage::Huge { ptr, len, .. } => unsafe { std::slice::from_raw_parts(ptr.as_ptr(), *len) },
-        }
+        // SAFETY: `ptr` holds `len` initialised elements for as long as `self` lives (in the
+        // vector `storage` owns, or in the allocation it records).
+        unsafe { std::slice::from_raw_parts(self.ptr.as_ptr(), self.len) }
     }
 }
 
 impl<T: Copy> Drop for PageBuf<T> {
     fn drop(&mut self) {
-        if let Storage::Huge { ptr, layout, .. } = self.storage {
+        if let Storage::Huge(layout) = self.storage {
             // SAFETY: allocated in `new` with this layout; `T: Copy` has no destructor.
-            unsafe { std::alloc::dealloc(ptr.as_ptr() as *mut u8, layout) };
+            unsafe { std::alloc::dealloc(self.ptr.as_ptr() as *mut u8, layout) };
         }
     }
 }
@@ -90,7 +100,7 @@ impl<T: Copy> Clone for PageBuf<T> {
 
 impl<T: Copy> Default for PageBuf<T> {
     fn default() -> PageBuf<T> {
-        PageBuf { storage: Storage::Small(Vec::new()) }
+        PageBuf::small(Vec::new())
     }
 }
 

@@ -74,15 +74,11 @@ impl<const W: usize> WideNode<W> {
 
 /// Per-ray constants of the box test. `near[a]` is the row of `bounds` that the ray enters
 /// through on axis `a` (min when the direction is positive), `far[a]` the one it leaves by,
-/// so the test needs no min/max per slab. Exit distances use `inv_far`, the reciprocal
-/// widened by [`FAR_SCALE`] once per ray, so that the widening is not one more dependent
-/// multiply on every node (traversal is a chain of dependent node tests: their latency is
-/// what it costs).
+/// so the test needs no min/max per slab.
 #[derive(Clone, Copy, Debug)]
 pub struct NodeRay {
     pub o: [f32; 3],
     pub inv: [f32; 3],
-    pub inv_far: [f32; 3],
     pub near: [usize; 3],
     pub far: [usize; 3],
     pub t_min: f32,
@@ -96,7 +92,6 @@ impl NodeRay {
         NodeRay {
             o: ray.origin.to_array(),
             inv,
-            inv_far: inv.map(|x| x * FAR_SCALE),
             near: [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)],
             far: [3 - 3 * neg(0), 4 - 3 * neg(1), 5 - 3 * neg(2)],
             t_min: ray.t_min,
@@ -105,9 +100,7 @@ impl NodeRay {
 }
 
 /// Widening of the far distance that keeps boxes touched exactly by a ray (flat boxes,
-/// rounding) from being missed; the same factor as the binary BVH's slab test. It widens
-/// the exit distances through `NodeRay::inv_far` and the ray's `t_max`, which the node
-/// kernels receive already widened.
+/// rounding) from being missed; the same factor as the binary BVH's slab test.
 pub const FAR_SCALE: f32 = 1.000_000_24;
 
 #[derive(Clone, Debug, Default)]
@@ -277,6 +270,7 @@ impl<const W: usize> WideBvh<W> {
             return false;
         }
         let nr = NodeRay::new(ray);
+        let nodes: &[WideNode<W>] = &self.nodes;
         let mut stack: [MaybeUninit<(u32, f32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut sp = 0usize;
         let mut cur = self.root;
@@ -284,10 +278,9 @@ impl<const W: usize> WideBvh<W> {
         loop {
             if cur & LEAF_BIT == 0 {
                 // SAFETY: child references are built by `collapse` and always in range.
-                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
-                prefetch(node.children.as_ptr());
+                let node = unsafe { nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
-                let mut mask = S::node(node, &nr, ray.t_max * FAR_SCALE, &mut dist);
+                let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -352,16 +345,16 @@ impl<const W: usize> WideBvh<W> {
             return false;
         }
         let nr = NodeRay::new(ray);
+        let nodes: &[WideNode<W>] = &self.nodes;
         let mut stack: [MaybeUninit<u32>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut sp = 0usize;
         let mut cur = self.root;
         loop {
             if cur & LEAF_BIT == 0 {
                 // SAFETY: child references are built by `collapse` and always in range.
-                let node = unsafe { self.nodes.get_unchecked(cur as usize) };
-                prefetch(node.children.as_ptr());
+                let node = unsafe { nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
-                let mut mask = S::node(node, &nr, ray.t_max * FAR_SCALE, &mut dist);
+                let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
                 if mask != 0 {
                     cur = node.children[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
@@ -387,20 +380,6 @@ impl<const W: usize> WideBvh<W> {
             cur = unsafe { stack.get_unchecked(sp).assume_init() };
         }
     }
-}
-
-/// Starts loading the cache line that holds a node's child references together with its
-/// bounds: the reference is needed only after the box test, and without this its load
-/// (another cache miss on incoherent rays) waits for the test's result.
-#[inline(always)]
-fn prefetch<T>(p: *const T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch never faults, whatever the address.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p as *const i8)
-    };
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
 }
 
 fn area(n: &BvhNode) -> f32 {

@@ -4,7 +4,7 @@
 use super::sse::tri4_sse;
 use super::Isa;
 use crate::accel::tri4::{Tri4, Tri4Hits, TriRay};
-use crate::accel::wide::{NodeRay, WideNode};
+use crate::accel::wide::{NodeRay, WideNode, FAR_SCALE};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy, Debug)]
@@ -12,23 +12,32 @@ pub struct Avx2;
 
 unsafe impl Isa for Avx2 {
     #[inline(always)]
-    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max_far: f32, dist: &mut [f32; W]) -> u32 {
+    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max: f32, dist: &mut [f32; W]) -> u32 {
         if W == 4 {
-            return super::Sse::node(node, r, t_max_far, dist);
+            return super::Sse::node(node, r, t_max, dist);
         }
         let mut mask = 0u32;
         let o = [_mm256_set1_ps(r.o[0]), _mm256_set1_ps(r.o[1]), _mm256_set1_ps(r.o[2])];
         let inv = [_mm256_set1_ps(r.inv[0]), _mm256_set1_ps(r.inv[1]), _mm256_set1_ps(r.inv[2])];
-        let inv_far = [_mm256_set1_ps(r.inv_far[0]), _mm256_set1_ps(r.inv_far[1]), _mm256_set1_ps(r.inv_far[2])];
-        let (t_min, t_max) = (_mm256_set1_ps(r.t_min), _mm256_set1_ps(t_max_far));
+        let (t_min, t_max, scale) = (_mm256_set1_ps(r.t_min), _mm256_set1_ps(t_max), _mm256_set1_ps(FAR_SCALE));
         for c in 0..W / 8 {
-            let row = |row: usize| _mm256_load_ps(node.bounds.get_unchecked(row).as_ptr().add(8 * c));
-            let near = |a: usize| _mm256_mul_ps(_mm256_sub_ps(row(r.near[a]), o[a]), inv[a]);
-            let far = |a: usize| _mm256_mul_ps(_mm256_sub_ps(row(r.far[a]), o[a]), inv_far[a]);
-            let t_near = _mm256_max_ps(_mm256_max_ps(near(0), near(1)), _mm256_max_ps(near(2), t_min));
-            let t_far = _mm256_min_ps(_mm256_min_ps(far(0), far(1)), _mm256_min_ps(far(2), t_max));
+            let slab = |row: usize, a: usize| {
+                _mm256_mul_ps(
+                    _mm256_sub_ps(_mm256_load_ps(node.bounds.get_unchecked(row).as_ptr().add(8 * c)), o[a]),
+                    inv[a],
+                )
+            };
+            let t_near = _mm256_max_ps(
+                slab(r.near[0], 0),
+                _mm256_max_ps(slab(r.near[1], 1), _mm256_max_ps(slab(r.near[2], 2), t_min)),
+            );
+            let t_far = _mm256_min_ps(
+                slab(r.far[0], 0),
+                _mm256_min_ps(slab(r.far[1], 1), _mm256_min_ps(slab(r.far[2], 2), t_max)),
+            );
             _mm256_storeu_ps(dist.as_mut_ptr().add(8 * c), t_near);
-            mask |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32) << (8 * c);
+            mask |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, scale))) as u32)
+                << (8 * c);
         }
         mask
     }

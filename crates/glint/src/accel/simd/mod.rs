@@ -115,12 +115,9 @@ impl std::fmt::Display for SimdPath {
 /// Implementations may use instructions that the CPU lacks; callers must only use an `Isa`
 /// whose [`SimdPath`] is available, from code compiled with its target features.
 pub unsafe trait Isa {
-    /// Slab test of the ray against the node's W child boxes within `(r.t_min, t_max_far)`,
-    /// where `t_max_far` is the ray's `t_max` widened by `FAR_SCALE`. Returns the mask of
-    /// children hit and writes each child's entry distance to `dist`. Every path computes
-    /// `max(max(s0, s1), max(s2, t_min))` (and the same for min) in this order, with `maxps`
-    /// NaN semantics: a NaN slab (ray in a slab's plane) drops out, conservatively.
-    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max_far: f32, dist: &mut [f32; W]) -> u32;
+    /// Slab test of the ray against the node's W child boxes within `(r.t_min, t_max)`.
+    /// Returns the mask of children hit and writes each child's entry distance to `dist`.
+    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max: f32, dist: &mut [f32; W]) -> u32;
     /// Watertight test of four triangles, bit-identical to `intersect_triangle`.
     unsafe fn tri4(block: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> Tri4Hits;
 }

@@ -3,7 +3,7 @@
 
 use super::Isa;
 use crate::accel::tri4::{tri4_scalar, Tri4, Tri4Hits, TriRay};
-use crate::accel::wide::{NodeRay, WideNode};
+use crate::accel::wide::{NodeRay, WideNode, FAR_SCALE};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Scalar;
@@ -29,15 +29,14 @@ fn min_ps(a: f32, b: f32) -> f32 {
 
 unsafe impl Isa for Scalar {
     #[inline(always)]
-    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max_far: f32, dist: &mut [f32; W]) -> u32 {
+    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max: f32, dist: &mut [f32; W]) -> u32 {
         let mut mask = 0;
         for i in 0..W {
-            let near = |a: usize| (node.bounds[r.near[a]][i] - r.o[a]) * r.inv[a];
-            let far = |a: usize| (node.bounds[r.far[a]][i] - r.o[a]) * r.inv_far[a];
-            let t_near = max_ps(max_ps(near(0), near(1)), max_ps(near(2), r.t_min));
-            let t_far = min_ps(min_ps(far(0), far(1)), min_ps(far(2), t_max_far));
+            let slab = |row: usize, a: usize| (node.bounds[row][i] - r.o[a]) * r.inv[a];
+            let t_near = max_ps(slab(r.near[0], 0), max_ps(slab(r.near[1], 1), max_ps(slab(r.near[2], 2), r.t_min)));
+            let t_far = min_ps(slab(r.far[0], 0), min_ps(slab(r.far[1], 1), min_ps(slab(r.far[2], 2), t_max)));
             dist[i] = t_near;
-            mask |= ((t_near <= t_far) as u32) << i;
+            mask |= ((t_near <= t_far * FAR_SCALE) as u32) << i;
         }
         mask
     }

@@ -2,7 +2,7 @@
 
 use super::Isa;
 use crate::accel::tri4::{tri4_scalar, Tri4, Tri4Hits, TriRay};
-use crate::accel::wide::{NodeRay, WideNode};
+use crate::accel::wide::{NodeRay, WideNode, FAR_SCALE};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy, Debug)]
@@ -10,24 +10,22 @@ pub struct Sse;
 
 unsafe impl Isa for Sse {
     #[inline(always)]
-    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max_far: f32, dist: &mut [f32; W]) -> u32 {
+    unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max: f32, dist: &mut [f32; W]) -> u32 {
         let mut mask = 0u32;
         let o = [_mm_set1_ps(r.o[0]), _mm_set1_ps(r.o[1]), _mm_set1_ps(r.o[2])];
         let inv = [_mm_set1_ps(r.inv[0]), _mm_set1_ps(r.inv[1]), _mm_set1_ps(r.inv[2])];
-        let inv_far = [_mm_set1_ps(r.inv_far[0]), _mm_set1_ps(r.inv_far[1]), _mm_set1_ps(r.inv_far[2])];
-        let (t_min, t_max) = (_mm_set1_ps(r.t_min), _mm_set1_ps(t_max_far));
+        let (t_min, t_max, scale) = (_mm_set1_ps(r.t_min), _mm_set1_ps(t_max), _mm_set1_ps(FAR_SCALE));
         for c in 0..W / 4 {
-            let near = |a: usize| {
-                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.near[a]].as_ptr().add(4 * c)), o[a]), inv[a])
-            };
-            let far = |a: usize| {
-                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.far[a]].as_ptr().add(4 * c)), o[a]), inv_far[a])
+            let slab = |row: usize, a: usize| {
+                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[row].as_ptr().add(4 * c)), o[a]), inv[a])
             };
             // NaN slabs (ray in a slab's plane) lose to the other operand: conservative.
-            let t_near = _mm_max_ps(_mm_max_ps(near(0), near(1)), _mm_max_ps(near(2), t_min));
-            let t_far = _mm_min_ps(_mm_min_ps(far(0), far(1)), _mm_min_ps(far(2), t_max));
+            let t_near =
+                _mm_max_ps(slab(r.near[0], 0), _mm_max_ps(slab(r.near[1], 1), _mm_max_ps(slab(r.near[2], 2), t_min)));
+            let t_far =
+                _mm_min_ps(slab(r.far[0], 0), _mm_min_ps(slab(r.far[1], 1), _mm_min_ps(slab(r.far[2], 2), t_max)));
             _mm_storeu_ps(dist.as_mut_ptr().add(4 * c), t_near);
-            mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, t_far)) as u32) << (4 * c);
+            mask |= (_mm_movemask_ps(_mm_cmple_ps(t_near, _mm_mul_ps(t_far, scale))) as u32) << (4 * c);
         }
         mask
     }
