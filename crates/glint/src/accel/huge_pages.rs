@@ -24,7 +24,9 @@ pub struct PageBuf<T: Copy> {
 enum Storage<T> {
     /// `ptr` points into this vector's buffer, which does not move with the vector; it is
     /// held only to keep the buffer alive.
-    Small { _owner: Vec<T> },
+    Small {
+        _owner: Vec<T>,
+    },
     Huge(Layout),
 }
 
