@@ -281,6 +281,26 @@ impl<const W: usize> WideBvh<W> {
                 let node = unsafe { nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
                 let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
+                // Leaf children are tested at once, before any subtree: a leaf is one test,
+                // and its hit shortens the ray, which culls the subtrees behind it (without
+                // this, each leaf went through the sorted stack and a mispredicted pop).
+                let mut leaves = mask & leaf_mask(node);
+                if leaves != 0 {
+                    while leaves != 0 {
+                        let (first, count) = leaf_range(node.children[leaves.trailing_zeros() as usize]);
+                        found |= leaf.test(first, count, ray);
+                        leaves &= leaves - 1;
+                    }
+                    mask &= !leaf_mask(node);
+                    let mut m = mask;
+                    while m != 0 {
+                        let i = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        if dist[i] > ray.t_max * FAR_SCALE {
+                            mask &= !(1 << i);
+                        }
+                    }
+                }
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -355,6 +375,18 @@ impl<const W: usize> WideBvh<W> {
                 let node = unsafe { nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
                 let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
+                // Leaves first: one leaf test may end the query, where a subtree costs many
+                // node tests before it can (large occluders such as walls sit in shallow
+                // leaves).
+                let mut leaves = mask & leaf_mask(node);
+                while leaves != 0 {
+                    let (first, count) = leaf_range(node.children[leaves.trailing_zeros() as usize]);
+                    if leaf.test(first, count, ray) {
+                        return true;
+                    }
+                    leaves &= leaves - 1;
+                }
+                mask &= !leaf_mask(node);
                 if mask != 0 {
                     cur = node.children[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
@@ -380,6 +412,30 @@ impl<const W: usize> WideBvh<W> {
             cur = unsafe { stack.get_unchecked(sp).assume_init() };
         }
     }
+}
+
+/// The children that are leaves (empty slots count as leaves, but no ray hits them): the
+/// sign bits of the child references, gathered by `movmskps` (SSE2, always present on
+/// x86-64) four at a time.
+#[inline(always)]
+fn leaf_mask<const W: usize>(node: &WideNode<W>) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if W % 4 == 0 {
+        use std::arch::x86_64::{_mm_castsi128_ps, _mm_loadu_si128, _mm_movemask_ps};
+        let mut m = 0;
+        for q in 0..W / 4 {
+            // SAFETY: reads four in-range `u32`s; SSE2 is part of the x86-64 baseline.
+            let bits =
+                unsafe { _mm_movemask_ps(_mm_castsi128_ps(_mm_loadu_si128(node.children.as_ptr().add(4 * q).cast()))) };
+            m |= (bits as u32) << (4 * q);
+        }
+        return m;
+    }
+    let mut m = 0;
+    for (i, c) in node.children.iter().enumerate() {
+        m |= (c >> 31) << i;
+    }
+    m
 }
 
 fn area(n: &BvhNode) -> f32 {
