@@ -7,7 +7,6 @@
 //! kernels are checked.
 
 use crate::math::{Aabb, Ray, Vec3};
-use rayon::prelude::*;
 
 /// How the builder chooses splits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -58,9 +57,6 @@ pub struct Bvh {
 /// defaults; the absolute scale is arbitrary, the ratio matters.
 pub const SAH_TRAVERSAL_COST: f32 = 1.0;
 pub const SAH_INTERSECT_COST: f32 = 1.0;
-const BINS: usize = 16;
-/// Subtrees above this size are built in parallel.
-const PARALLEL_THRESHOLD: usize = 4096;
 
 /// Statistics that `glint info` reports.
 #[derive(Clone, Debug, Default)]
@@ -99,18 +95,6 @@ impl Default for BuildOptions {
     }
 }
 
-struct BuildRef {
-    bounds: Aabb,
-    centre: Vec3,
-    index: u32,
-}
-
-/// A subtree built on its own, with node links relative to its own first node.
-struct Subtree {
-    nodes: Vec<BvhNode>,
-    prims: Vec<u32>,
-}
-
 impl Bvh {
     /// Builds over `bounds[i]` for each primitive `i`. Empty boxes are allowed (degenerate
     /// triangles) and end up in leaves that no ray can hit.
@@ -123,17 +107,8 @@ impl Bvh {
         if bounds.is_empty() {
             return Bvh::default();
         }
-        let mut refs: Vec<BuildRef> = bounds
-            .iter()
-            .enumerate()
-            .map(|(i, b)| BuildRef {
-                bounds: *b,
-                centre: if b.is_empty() { Vec3::ZERO } else { b.center() },
-                index: i as u32,
-            })
-            .collect();
-        let tree = build_subtree(&mut refs, split, opts);
-        Bvh { nodes: tree.nodes, prim_indices: tree.prims }
+        let (nodes, prim_indices) = super::build::build(bounds, split, opts);
+        Bvh { nodes, prim_indices }
     }
 
     pub fn bounds(&self) -> Aabb {
@@ -261,152 +236,6 @@ impl Bvh {
         s.bytes = self.nodes.len() * std::mem::size_of::<BvhNode>() + self.prim_indices.len() * 4;
         s
     }
-}
-
-fn build_subtree(refs: &mut [BuildRef], split: BvhSplit, opts: BuildOptions) -> Subtree {
-    let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds));
-    let n = refs.len();
-    let make_leaf = |refs: &mut [BuildRef]| Subtree {
-        nodes: vec![BvhNode { bounds, first: 0, count: refs.len() as u32 }],
-        prims: refs.iter().map(|r| r.index).collect(),
-    };
-    if n <= opts.leaf_at_most.max(1) {
-        return make_leaf(refs);
-    }
-    let centre_bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.grow(r.centre));
-    let axis = centre_bounds.extent().max_axis();
-    let extent = centre_bounds.extent()[axis];
-
-    let mid = match split {
-        BvhSplit::Median => {
-            if n <= 1 {
-                return make_leaf(refs);
-            }
-            let m = n / 2;
-            refs.select_nth_unstable_by(m, |a, b| a.centre[axis].total_cmp(&b.centre[axis]));
-            m
-        }
-        BvhSplit::Sah => {
-            if extent <= 0.0 {
-                // All centres coincide: no split separates them.
-                if n <= opts.max_leaf {
-                    return make_leaf(refs);
-                }
-                n / 2
-            } else {
-                match best_sah_split(refs, &centre_bounds, bounds.area()) {
-                    Some((axis, pos, cost)) => {
-                        let leaf_cost = SAH_INTERSECT_COST * n as f32;
-                        if cost >= leaf_cost && n <= opts.max_leaf {
-                            return make_leaf(refs);
-                        }
-                        let m = partition(refs, |r| bin_of(r.centre[axis], &centre_bounds, axis) < pos);
-                        if m == 0 || m == n {
-                            n / 2
-                        } else {
-                            m
-                        }
-                    }
-                    None => n / 2,
-                }
-            }
-        }
-    };
-
-    let (left, right) = refs.split_at_mut(mid);
-    let (l, r) = if n > PARALLEL_THRESHOLD {
-        rayon::join(|| build_subtree(left, split, opts), || build_subtree(right, split, opts))
-    } else {
-        (build_subtree(left, split, opts), build_subtree(right, split, opts))
-    };
-    // Layout: [node, left child, right child, rest of left subtree..., rest of right subtree...]
-    // so that siblings are adjacent.
-    let mut nodes = Vec::with_capacity(1 + l.nodes.len() + r.nodes.len());
-    nodes.push(BvhNode { bounds, first: 1, count: 0 });
-    let left_base = 3u32; // where left's nodes[1..] go
-    let right_base = left_base + (l.nodes.len() as u32 - 1);
-    let relink = |node: BvhNode, prim_off: u32, base: u32| -> BvhNode {
-        if node.is_leaf() {
-            BvhNode { first: node.first + prim_off, ..node }
-        } else {
-            // Children of a subtree's node k are at `first`, `first+1` within that subtree;
-            // subtree index j >= 1 maps to base + j - 1, index 0 never appears as a child.
-            BvhNode { first: base + node.first - 1, ..node }
-        }
-    };
-    let l_prims = l.prims.len() as u32;
-    nodes.push(relink(l.nodes[0], 0, left_base));
-    nodes.push(relink(r.nodes[0], l_prims, right_base));
-    nodes.extend(l.nodes[1..].iter().map(|&nd| relink(nd, 0, left_base)));
-    nodes.extend(r.nodes[1..].iter().map(|&nd| relink(nd, l_prims, right_base)));
-    let mut prims = l.prims;
-    prims.extend(r.prims);
-    Subtree { nodes, prims }
-}
-
-#[inline]
-fn bin_of(c: f32, cb: &Aabb, axis: usize) -> usize {
-    let lo = cb.min[axis];
-    let ext = cb.max[axis] - lo;
-    (((c - lo) / ext * BINS as f32) as usize).min(BINS - 1)
-}
-
-/// Best binned-SAH split across all three axes: (axis, first bin of the right side, cost).
-fn best_sah_split(refs: &[BuildRef], cb: &Aabb, parent_area: f32) -> Option<(usize, usize, f32)> {
-    let bin_axis = |axis: usize| -> Option<(usize, usize, f32)> {
-        if cb.extent()[axis] <= 0.0 {
-            return None;
-        }
-        let mut boxes = [Aabb::EMPTY; BINS];
-        let mut counts = [0usize; BINS];
-        for r in refs {
-            let b = bin_of(r.centre[axis], cb, axis);
-            boxes[b] = boxes[b].union(r.bounds);
-            counts[b] += 1;
-        }
-        let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0usize; BINS];
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-        for i in (1..BINS).rev() {
-            acc = acc.union(boxes[i]);
-            cnt += counts[i];
-            right_area[i] = acc.area();
-            right_count[i] = cnt;
-        }
-        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
-        let mut best: Option<(usize, usize, f32)> = None;
-        for i in 1..BINS {
-            acc = acc.union(boxes[i - 1]);
-            cnt += counts[i - 1];
-            if cnt == 0 || right_count[i] == 0 {
-                continue;
-            }
-            let cost = SAH_TRAVERSAL_COST
-                + SAH_INTERSECT_COST * (acc.area() * cnt as f32 + right_area[i] * right_count[i] as f32)
-                    / parent_area.max(f32::MIN_POSITIVE);
-            if best.is_none_or(|b| cost < b.2) {
-                best = Some((axis, i, cost));
-            }
-        }
-        best
-    };
-    let results: Vec<_> = if refs.len() > PARALLEL_THRESHOLD {
-        (0..3).into_par_iter().map(bin_axis).collect()
-    } else {
-        (0..3).map(bin_axis).collect()
-    };
-    results.into_iter().flatten().min_by(|a, b| a.2.total_cmp(&b.2))
-}
-
-fn partition<T>(v: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
-    let mut i = 0;
-    for j in 0..v.len() {
-        if pred(&v[j]) {
-            v.swap(i, j);
-            i += 1;
-        }
-    }
-    i
 }
 
 #[cfg(test)]

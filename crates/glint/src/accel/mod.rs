@@ -1,6 +1,8 @@
 //! Acceleration structures: the binary SAH BVH (the reference), the wide SIMD BVH collapsed
 //! from it, and triangle intersection.
 
+mod binning;
+mod build;
 mod bvh;
 mod huge_pages;
 pub mod simd;
