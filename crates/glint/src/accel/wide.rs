@@ -420,7 +420,7 @@ impl<const W: usize> WideBvh<W> {
 #[inline(always)]
 fn leaf_mask<const W: usize>(node: &WideNode<W>) -> u32 {
     #[cfg(target_arch = "x86_64")]
-    if W % 4 == 0 {
+    if W.is_multiple_of(4) {
         use std::arch::x86_64::{_mm_castsi128_ps, _mm_loadu_si128, _mm_movemask_ps};
         let mut m = 0;
         for q in 0..W / 4 {
