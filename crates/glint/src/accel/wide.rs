@@ -3,8 +3,9 @@
 //!
 //! Collapse (as in Embree's BVH4/8 and tinybvh): a wide node takes the children of a binary
 //! node and keeps replacing its largest-area interior child by that child's two children
-//! until it has W children or only leaves. Traversal visits hit children nearest first and
-//! culls popped entries that lie beyond the closest hit found so far.
+//! until it has W children or only leaves. Traversal tests a node's hit leaf children at once,
+//! then visits its hit interior children nearest first, and culls popped entries that lie
+//! beyond the closest hit found so far.
 //!
 //! The tree does not know what its leaves hold: a leaf is a range `(first, count)` of
 //! "items" (blocks of four triangles for a mesh, primitive indices for the scene's top
