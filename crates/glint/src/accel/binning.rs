@@ -196,18 +196,19 @@ mod tests {
             .collect()
     }
 
-    fn centre_bounds(rs: &[R]) -> Aabb {
-        rs.iter().fold(Aabb::EMPTY, |b, r| b.grow(r.centre()))
+    /// `n` references, their bin map and the area of their box.
+    fn setup(n: usize) -> (Vec<R>, BinMap, f32) {
+        let rs = refs(n);
+        let map = BinMap::new(&rs.iter().fold(Aabb::EMPTY, |b, r| b.grow(r.centre())));
+        let area = rs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.0)).area();
+        (rs, map, area)
     }
 
     /// The one-pass search scores every candidate exactly as the definition does: for each
     /// axis and boundary, the SAH of the two sides' boxes and counts, found here by brute force.
     #[test]
     fn best_split_is_the_brute_force_minimum() {
-        let rs = refs(3000);
-        let cb = centre_bounds(&rs);
-        let map = BinMap::new(&cb);
-        let area = rs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.0)).area();
+        let (rs, map, area) = setup(3000);
         let mut want: Option<Split> = None;
         for axis in 0..3 {
             for bin in 1..BINS {
@@ -235,10 +236,7 @@ mod tests {
 
     #[test]
     fn parallel_chunks_give_the_same_split() {
-        let rs = refs(100_000);
-        let cb = centre_bounds(&rs);
-        let map = BinMap::new(&cb);
-        let area = rs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.0)).area();
+        let (rs, map, area) = setup(100_000);
         assert_eq!(best_split(&rs, &map, area, true), best_split(&rs, &map, area, false));
     }
 

@@ -285,14 +285,15 @@ impl<const W: usize> WideBvh<W> {
                 // Leaf children are tested at once, before any subtree: a leaf is one test,
                 // and its hit shortens the ray, which culls the subtrees behind it (without
                 // this, each leaf went through the sorted stack and a mispredicted pop).
-                let mut leaves = mask & leaf_mask(node);
+                let leaf_bits = leaf_mask(node);
+                let mut leaves = mask & leaf_bits;
                 if leaves != 0 {
                     while leaves != 0 {
                         let (first, count) = leaf_range(node.children[leaves.trailing_zeros() as usize]);
                         found |= leaf.test(first, count, ray);
                         leaves &= leaves - 1;
                     }
-                    mask &= !leaf_mask(node);
+                    mask &= !leaf_bits;
                     let mut m = mask;
                     while m != 0 {
                         let i = m.trailing_zeros() as usize;
@@ -379,7 +380,8 @@ impl<const W: usize> WideBvh<W> {
                 // Leaves first: one leaf test may end the query, where a subtree costs many
                 // node tests before it can (large occluders such as walls sit in shallow
                 // leaves).
-                let mut leaves = mask & leaf_mask(node);
+                let leaf_bits = leaf_mask(node);
+                let mut leaves = mask & leaf_bits;
                 while leaves != 0 {
                     let (first, count) = leaf_range(node.children[leaves.trailing_zeros() as usize]);
                     if leaf.test(first, count, ray) {
@@ -387,7 +389,7 @@ impl<const W: usize> WideBvh<W> {
                     }
                     leaves &= leaves - 1;
                 }
-                mask &= !leaf_mask(node);
+                mask &= !leaf_bits;
                 if mask != 0 {
                     cur = node.children[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
