@@ -1,14 +1,26 @@
 //! glint: a physically based renderer for the CPU.
 //!
-//! The crate is organised one concept per module: [`math`], [`sampling`], [`accel`] (BVH),
-//! [`geometry`] (shapes), [`bsdf`] and [`materials`], [`lights`], [`camera`],
-//! [`integrators`], [`render`] (tiles, threads), [`scene`] (descriptions and the
-//! render-ready scene) and [`io`] (images and meshes). Front ends (the `glint` command line)
-//! live in their own crates and only call into this one.
+//! The library is a pipeline whose modules read in order:
+//! - [`formats`] read files (native JSON, Mitsuba XML, bare OBJ/PLY) into a
+//!   [`describe::SceneDesc`], plain data that remembers where each entity came from;
+//! - [`build`] turns a description into the render-ready [`world::World`] (meshes loaded
+//!   once, BVHs built in parallel, area lights made, every default applied);
+//! - [`integrators`] estimate radiance along rays of a world; [`render`] schedules passes of
+//!   samples over tiles and threads into a film;
+//! - [`session`] ties these together behind one API, which every front end (the `glint`
+//!   command line, Python) uses.
+//!
+//! Below them: [`math`], [`sampling`], [`accel`] (BVHs over boxes and triangles),
+//! [`geometry`] (shapes), [`bsdf`] and [`materials`], [`lights`], [`camera`], [`io`] (images
+//! and meshes) and [`error`] (one error type with a source location).
 
 pub mod accel;
 pub mod bsdf;
+pub mod build;
 pub mod camera;
+pub mod describe;
+pub mod error;
+pub mod formats;
 pub mod geometry;
 pub mod integrators;
 pub mod io;
@@ -17,4 +29,7 @@ pub mod materials;
 pub mod math;
 pub mod render;
 pub mod sampling;
-pub mod scene;
+pub mod session;
+pub mod world;
+
+pub use error::{Error, SourceLoc};

@@ -5,11 +5,13 @@
 //! with transformed instances, are checked.
 
 use glint::accel::BvhSplit;
+use glint::build::WorldBuilder;
 use glint::camera::{Camera, FovAxis};
 use glint::geometry::TriangleMesh;
+use glint::lights::LightSelection;
 use glint::materials::{Material, MaterialKind, Texture};
 use glint::math::{vec3, Ray, Rgb, Transform, Vec3};
-use glint::scene::{LightSelection, Scene, SceneBuilder};
+use glint::world::World;
 use proptest::prelude::*;
 use std::sync::Arc;
 
@@ -113,7 +115,7 @@ proptest! {
         ray_params in prop::collection::vec((any::<u8>(), -1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0), 48),
     ) {
         let mesh = Arc::new(mesh_from(&points, &heights, BvhSplit::Sah));
-        let mut b = SceneBuilder::new(BvhSplit::Sah);
+        let mut b = WorldBuilder::new(BvhSplit::Sah);
         let m = b.add_material(Material::new("m", MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) }, true));
         for (i, &(x, y, z, angle, s)) in placements.iter().enumerate() {
             let t = Transform::translate(vec3(x, y, z))
@@ -126,7 +128,7 @@ proptest! {
             b.add_sphere(vec3(x, y, z), r, &Transform::IDENTITY, m, None, false).unwrap();
         }
         let cam = Camera::new(Transform::IDENTITY, 4, 4, 40.0, FovAxis::Y);
-        let scene: Scene = b.finish(cam, LightSelection::Power).unwrap();
+        let scene: World = b.finish(cam, LightSelection::Power).unwrap();
         for ray in rays_for(&mesh, &ray_params) {
             let reference = scene.intersect_brute_force(&ray);
             let got = scene.intersect(&ray);

@@ -16,12 +16,14 @@ mod common;
 use common::scenes::{cornell_box, emission, render_with};
 use common::stats::{z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
+use glint::build::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
+use glint::lights::LightSelection;
 use glint::materials::{Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::render::RenderOutput;
-use glint::scene::{LightSelection, Scene, SceneBuilder};
+use glint::world::World;
 use std::sync::Arc;
 
 const LEVELS: [u32; 4] = [4, 16, 64, 256];
@@ -59,7 +61,7 @@ fn mean_squared_error(out: &RenderOutput, truth: &Truth) -> (f64, f64) {
 }
 
 /// Weighted least-squares slope of log RMSE against log spp, and its standard error.
-fn fitted_slope(scene: &Scene, integrator: &Integrator, truth: &Truth, seed: u64) -> (f64, f64) {
+fn fitted_slope(scene: &World, integrator: &Integrator, truth: &Truth, seed: u64) -> (f64, f64) {
     let (mut xs, mut ys, mut ws) = (Vec::new(), Vec::new(), Vec::new());
     for (i, &spp) in LEVELS.iter().enumerate() {
         let out = render_with(scene, integrator, spp, seed + i as u64);
@@ -101,7 +103,7 @@ fn cornell_box_error_falls_as_inverse_sqrt_spp() {
 
 #[test]
 fn furnace_error_falls_as_inverse_sqrt_spp() {
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     let wall = b.add_material(Material::new(
         "wall",
         MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },

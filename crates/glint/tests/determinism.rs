@@ -12,9 +12,9 @@ use glint::integrators::{Integrator, Strategy, WhittedSettings};
 use glint::materials::{Material, MaterialKind};
 use glint::math::{vec3, Rgb, Transform};
 use glint::render::{render, RenderOutput, RenderSettings, Silent};
-use glint::scene::Scene;
+use glint::world::World;
 
-fn scene() -> Scene {
+fn scene() -> World {
     // 30×22: tiles of most sizes leave partial tiles at the right and bottom.
     cornell_box_with(30, 22, |b| {
         let glass = b.add_material(Material::new(
@@ -28,7 +28,7 @@ fn scene() -> Scene {
     })
 }
 
-fn render_on(threads: usize, scene: &Scene, integrator: &Integrator, tile_size: usize) -> RenderOutput {
+fn render_on(threads: usize, scene: &World, integrator: &Integrator, tile_size: usize) -> RenderOutput {
     let settings = RenderSettings { spp: 8, seed: 3, tile_size, variance: true, ..Default::default() };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| render(scene, integrator, &settings, &Silent))

@@ -14,11 +14,13 @@ use common::analytic::{disk_irradiance, polygon_irradiance, sphere_irradiance};
 use common::scenes::{add_quad, add_square, black, camera, diffuse, emission, path, render_with};
 use common::stats::{image_estimate, z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
+use glint::build::WorldBuilder;
 use glint::geometry::disk_mesh;
 use glint::integrators::Strategy;
 use glint::lights::Light;
+use glint::lights::LightSelection;
 use glint::math::{vec3, Rgb, Transform, Vec3, PI};
-use glint::scene::{LightSelection, Scene, SceneBuilder};
+use glint::world::World;
 use std::sync::Arc;
 
 const ALBEDO: f32 = 0.8;
@@ -30,21 +32,21 @@ const AREA_STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::Light, Strategy
 const DELTA_STRATEGIES: [Strategy; 2] = [Strategy::Mis, Strategy::Light];
 
 /// A builder holding the receiving plane y = 0 (normal +y); the camera looks at the origin.
-fn receiver() -> SceneBuilder {
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+fn receiver() -> WorldBuilder {
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     let plane = diffuse(&mut b, "plane", Rgb::splat(ALBEDO));
     add_square(&mut b, Vec3::ZERO, 1, 1.0, 50.0, plane, None);
     b
 }
 
-fn finish(b: SceneBuilder) -> Scene {
+fn finish(b: WorldBuilder) -> World {
     // 0.001° across 4 pixels: the pixels see the plane within ~1e-4 of the origin.
     let cam = camera(vec3(2.5, 0.6, 1.2), Vec3::ZERO, Vec3::Y, 0.001, 4, 4);
     b.finish(cam, LightSelection::Power).unwrap()
 }
 
 /// Renders `scene` with each strategy and compares the mean radiance with ρ/π · E.
-fn check(label: &str, scene: &Scene, irradiance: f64, strategies: &[Strategy], failures: &mut Vec<String>, k: f64) {
+fn check(label: &str, scene: &World, irradiance: f64, strategies: &[Strategy], failures: &mut Vec<String>, k: f64) {
     let exact = ALBEDO as f64 / PI as f64 * irradiance;
     for (i, &s) in strategies.iter().enumerate() {
         let out = render_with(scene, &path(s), SPP, 7 + i as u64);
@@ -90,13 +92,13 @@ fn disk_light_above_the_point() {
     let xf = Transform::translate(vec3(0.0, h, 0.0))
         .then_after(&Transform::rotate(Vec3::X, 90.0))
         .then_after(&Transform::scale(Vec3::splat(r)).unwrap());
-    let disk = disk_mesh(64, BvhSplit::Sah);
+    let disk = disk_mesh(BvhSplit::Sah);
     let ring: Vec<Vec3> = disk.positions[1..].iter().map(|&p| xf.point(p)).collect();
     assert!(xf.vector(Vec3::Z).y < 0.0, "the disk must face the plane");
     b.add_mesh_instance(&Arc::new(disk), &xf, false, m, emission(le), false).unwrap();
     let scene = finish(b);
     let e = polygon_irradiance(Vec3::ZERO, Vec3::Y, &ring, le as f64);
-    // The 64-gon is within 0.2% of the disk (a check that the set-up is what it claims).
+    // The polygon is within 0.2% of the disk (a check that the set-up is what it claims).
     assert!((e / disk_irradiance(le as f64, r as f64, h as f64) - 1.0).abs() < 2e-3);
     let mut failures = Vec::new();
     check("disk", &scene, e, &AREA_STRATEGIES, &mut failures, z_critical(FALSE_ALARM, AREA_STRATEGIES.len()));

@@ -11,11 +11,13 @@ mod common;
 use common::scenes::{camera, render_with};
 use common::stats::{check_constant_image, constant_image_comparisons, z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
+use glint::build::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
+use glint::lights::LightSelection;
 use glint::materials::{Material, MaterialKind};
 use glint::math::{vec3, Rgb, Transform, Vec3};
-use glint::scene::{LightSelection, Scene, SceneBuilder};
+use glint::world::World;
 use std::sync::Arc;
 
 const LE: f32 = 0.7;
@@ -30,8 +32,8 @@ fn glass() -> MaterialKind {
     MaterialKind::Dielectric { eta: ETA, reflect: Rgb::WHITE, transmit: Rgb::WHITE }
 }
 
-fn scene_with(kind: MaterialKind, eye: Vec3) -> Scene {
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+fn scene_with(kind: MaterialKind, eye: Vec3) -> World {
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     let m = b.add_material(Material::new("specular", kind, false));
     b.add_sphere(vec3(0.0, 0.0, 0.0), 1.0, &Transform::IDENTITY, m, None, false).unwrap();
     // A slab beside it: flat faces and edges, where total internal reflection happens.
@@ -51,7 +53,7 @@ fn without_roulette(strategy: Strategy) -> Integrator {
 
 /// Every pixel equal to `exact` (no roulette), then image and block means (roulette on),
 /// for every strategy.
-fn check(label: &str, scene: &Scene, exact: f32) {
+fn check(label: &str, scene: &World, exact: f32) {
     let strategies = [Strategy::Mis, Strategy::Light, Strategy::Bsdf];
     let mut failures = Vec::new();
     for s in strategies {

@@ -9,10 +9,13 @@ use common::scenes::{add_quad, add_square, black, camera, diffuse, emission, ren
 use common::stats::{block_estimates, image_estimate, z_critical, Estimate, FALSE_ALARM};
 use glint::accel::BvhSplit;
 use glint::bsdf::{Microfacet, MicrofacetKind};
+use glint::build::WorldBuilder;
+use glint::describe::Emission;
 use glint::integrators::{Integrator, PathSettings, Strategy};
+use glint::lights::LightSelection;
 use glint::materials::{Material, MaterialKind};
 use glint::math::{rgb, vec3, Rgb, Transform, Vec3};
-use glint::scene::{Emission, LightSelection, Scene, SceneBuilder};
+use glint::world::World;
 
 const SIZE: u32 = 32;
 const BLOCK: usize = 8;
@@ -21,14 +24,14 @@ const SPP: u32 = 256;
 const LONG_SPP: u32 = 8192;
 const STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::Light, Strategy::Bsdf];
 
-fn glossy(b: &mut SceneBuilder, name: &str) -> u32 {
+fn glossy(b: &mut WorldBuilder, name: &str) -> u32 {
     let dist = Microfacet::new(MicrofacetKind::Ggx, 0.2);
     let (eta, k) = (rgb(0.2, 0.92, 1.1), rgb(3.9, 2.45, 2.14)); // copper
     b.add_material(Material::new(name, MaterialKind::RoughConductor { dist, eta, k, specular: Rgb::WHITE }, true))
 }
 
-fn scene() -> Scene {
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+fn scene() -> World {
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     let floor = glossy(&mut b, "floor");
     let ball = glossy(&mut b, "ball");
     let wall = diffuse(&mut b, "wall", Rgb::splat(0.6));
@@ -47,7 +50,7 @@ fn scene() -> Scene {
 
 /// Renders `scene` with each strategy (seeds differ, so estimates are independent) and
 /// compares every pair on the whole image and on each block, channel by channel.
-fn assert_strategies_agree(scene: &Scene, settings: PathSettings, spp: u32) {
+fn assert_strategies_agree(scene: &World, settings: PathSettings, spp: u32) {
     let estimates: Vec<(Strategy, Vec<[Estimate; 3]>)> = STRATEGIES
         .iter()
         .enumerate()
@@ -110,7 +113,7 @@ fn strategies_agree_on_emitters_seen_from_behind() {
     // One-sided emitters send nothing backwards: a quad light facing away from the floor
     // and a sphere light with inward normals (it lights only its inside). Light sampling
     // must not count what BSDF sampling cannot see. A plain quad light keeps the image lit.
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     let floor = diffuse(&mut b, "floor", Rgb::splat(0.7));
     let lamp = black(&mut b);
     add_square(&mut b, Vec3::ZERO, 1, 1.0, 3.0, floor, None);

@@ -7,7 +7,9 @@
 
 use glint::io::{read_image, Image};
 use glint::render::{render, Silent};
-use glint::scene::{load, LoadOptions};
+mod common;
+
+use common::load::load;
 use std::path::{Path, PathBuf};
 
 fn dir() -> PathBuf {
@@ -34,10 +36,10 @@ fn reference_entry(name: &str) -> serde_json::Value {
 }
 
 fn render_at(name: &str, spp: u64) -> Image {
-    let opts = LoadOptions { defines: vec![("spp".into(), spp.to_string())], ..Default::default() };
-    let scene = load(&dir().join(format!("{name}.xml")), &opts).unwrap();
+    let spp_text = spp.to_string();
+    let scene = load(&dir().join(format!("{name}.xml")), &[("spp", &spp_text)], None).unwrap();
     assert_eq!(scene.settings.spp as u64, spp);
-    render(&scene.scene, &scene.integrator, &scene.settings, &Silent).image
+    render(&scene.world, &scene.integrator, &scene.settings, &Silent).image
 }
 
 /// Criterion (a): every channel mean within 1% of Mitsuba's.

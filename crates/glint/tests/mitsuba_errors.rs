@@ -1,6 +1,8 @@
 //! Bad Mitsuba XML gets a one-line error naming the file and line.
 
-use glint::scene::{load, LoadOptions};
+mod common;
+
+use common::load::load;
 use std::path::PathBuf;
 
 fn write(name: &str, text: &str) -> PathBuf {
@@ -16,7 +18,7 @@ const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="40"/
 
 fn error_of(name: &str, text: &str) -> String {
     let p = write(name, text);
-    match load(&p, &LoadOptions::default()) {
+    match load(&p, &[], None) {
         Ok(_) => panic!("{name} loaded but should not"),
         Err(e) => {
             assert!(!e.contains('\n'), "not one line: {e}");
@@ -68,10 +70,10 @@ fn defines_override_defaults_and_refs_resolve() {
         "<scene version=\"3.0.0\">\n<default name=\"r\" value=\"0.5\"/>\n{SENSOR}\n<bsdf type=\"diffuse\" id=\"m\"/>\n<shape type=\"sphere\">\n <float name=\"radius\" value=\"$r\"/>\n <ref id=\"m\"/>\n</shape>\n</scene>\n"
     );
     let p = write("ok.xml", &text);
-    let s = load(&p, &LoadOptions::default()).unwrap();
-    assert!((s.scene.spheres[0].radius - 0.5).abs() < 1e-6);
-    let s = load(&p, &LoadOptions { defines: vec![("r".into(), "2".into())], ..Default::default() }).unwrap();
-    assert!((s.scene.spheres[0].radius - 2.0).abs() < 1e-6);
+    let s = load(&p, &[], None).unwrap();
+    assert!((s.world.spheres()[0].radius - 0.5).abs() < 1e-6);
+    let s = load(&p, &[("r", "2")], None).unwrap();
+    assert!((s.world.spheres()[0].radius - 2.0).abs() < 1e-6);
     let e = error_of("badref.xml", &text.replace("<ref id=\"m\"/>", "<ref id=\"nope\"/>"));
     assert!(e.contains("badref.xml:8:") && e.contains("nope"), "{e}");
 }

@@ -3,12 +3,14 @@
 
 use glint::render::{render, RenderSettings, Silent};
 use glint::sampling::SamplerKind;
-use glint::scene::{load, LoadOptions};
+mod common;
+
+use common::load::{load, Loaded};
 use std::path::Path;
 
-fn cornell(w: u32) -> glint::scene::LoadedScene {
+fn cornell(w: u32) -> Loaded {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.json");
-    load(&path, &LoadOptions { width: Some(w), height: Some(w), ..Default::default() }).unwrap()
+    load(&path, &[], Some((w, w))).unwrap()
 }
 
 /// Image mean per channel and its standard error, from per-pixel variances (pixels are
@@ -32,7 +34,7 @@ fn sobol_and_independent_agree_in_expectation() {
     let mut outs = Vec::new();
     for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
         let settings = RenderSettings { spp: 64, seed: 5, sampler, variance: true, ..Default::default() };
-        outs.push(render(&scene.scene, &scene.integrator, &settings, &Silent));
+        outs.push(render(&scene.world, &scene.integrator, &settings, &Silent));
     }
     let (mi, ei) = mean_and_error(&outs[0]);
     // The per-pixel sample variance overestimates a QMC estimate's variance, so this error
@@ -49,14 +51,14 @@ fn sobol_and_independent_agree_in_expectation() {
 fn sobol_has_lower_error_than_independent_at_equal_spp() {
     let scene = cornell(32);
     let reference = render(
-        &scene.scene,
+        &scene.world,
         &scene.integrator,
         &RenderSettings { spp: 1024, seed: 1, sampler: SamplerKind::Independent, ..Default::default() },
         &Silent,
     );
     let mse = |sampler| {
         let out = render(
-            &scene.scene,
+            &scene.world,
             &scene.integrator,
             &RenderSettings { spp: 16, seed: 2, sampler, ..Default::default() },
             &Silent,

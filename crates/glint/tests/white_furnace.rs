@@ -12,11 +12,13 @@ mod common;
 use common::scenes::{add_square, camera, diffuse, emission, render_with};
 use common::stats::{check_constant_image, constant_image_comparisons, z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
+use glint::build::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
+use glint::lights::LightSelection;
 use glint::materials::{Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
-use glint::scene::{LightSelection, Scene, SceneBuilder};
+use glint::world::World;
 use std::sync::Arc;
 
 const SIZE: u32 = 16;
@@ -46,7 +48,7 @@ fn integrators(p: f32) -> Vec<(String, Integrator)> {
     v
 }
 
-fn check_all(scene: &Scene, exact: f64, roulette_p: f32, spp: u32) {
+fn check_all(scene: &World, exact: f64, roulette_p: f32, spp: u32) {
     let integrators = integrators(roulette_p);
     let k =
         z_critical(FALSE_ALARM, integrators.len() * constant_image_comparisons(SIZE as usize, SIZE as usize, BLOCK));
@@ -61,9 +63,9 @@ fn check_all(scene: &Scene, exact: f64, roulette_p: f32, spp: u32) {
 /// Radiance of the environment around the open box.
 const ENV: f32 = 0.5;
 
-fn open_box_in_environment() -> Scene {
+fn open_box_in_environment() -> World {
     let le = ENV;
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     let white = diffuse(&mut b, "white", Rgb::WHITE);
     // A box open at the top (paths bounce many times inside) with a ball in it.
     add_square(&mut b, vec3(0.0, -1.0, 0.0), 1, 1.0, 1.0, white, None);
@@ -81,9 +83,9 @@ fn open_box_in_environment() -> Scene {
 const LE: f32 = 1.0;
 const ALBEDO: f32 = 0.5;
 
-fn emitting_enclosure() -> Scene {
+fn emitting_enclosure() -> World {
     let (le, a) = (LE, ALBEDO);
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     // One-sided, so that a wrongly oriented surface would show up black.
     let wall = b.add_material(Material::new(
         "wall",
@@ -100,7 +102,7 @@ fn emitting_enclosure() -> Scene {
     b.add_mesh_instance(&Arc::new(cube_mesh(BvhSplit::Sah)), &xf, false, wall, emission(le), false).unwrap();
     let cam = camera(vec3(-0.8, 0.8, -1.8), vec3(0.2, -0.3, 0.0), Vec3::Y, 70.0, SIZE, SIZE);
     let scene = b.finish(cam, LightSelection::Power).unwrap();
-    assert_eq!(scene.lights.len(), 2);
+    assert_eq!(scene.lights().len(), 2);
     scene
 }
 

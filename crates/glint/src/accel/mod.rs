@@ -14,7 +14,7 @@ mod wide_mesh;
 
 pub use bvh::{BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
 pub use simd::SimdPath;
-pub use top_level::TopLevelBvh;
+pub use top_level::{FlatMesh, TopLevelBvh};
 pub use triangle::{intersect_triangle, ShearedRay, TriangleHit};
 pub use wide::{WideBvh, WideStats};
 pub use wide_mesh::TriangleWideBvh;

@@ -14,8 +14,22 @@ use super::simd::{Isa, Scalar, SimdPath};
 use super::triangle::TriangleHit;
 use super::wide::{leaf_ref, FnLeaf, WideBvh};
 use super::wide_mesh::TriangleWideBvh;
-use crate::geometry::TriangleMesh;
-use crate::math::{Aabb, Ray};
+use crate::math::{Aabb, Ray, Vec3};
+
+/// The triangles of one instance merged into the flat BVH (already in world space).
+#[derive(Clone, Copy, Debug)]
+pub struct FlatMesh<'a> {
+    pub instance: u32,
+    pub positions: &'a [Vec3],
+    pub indices: &'a [[u32; 3]],
+}
+
+impl FlatMesh<'_> {
+    fn vertices(&self, t: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[t];
+        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+    }
+}
 
 #[derive(Clone, Debug, Default)]
 pub struct TopLevelBvh {
@@ -38,8 +52,8 @@ impl TopLevelBvh {
 
     /// A tree over the instances not in `flat`, plus one merged BVH over the triangles of the
     /// instances in `flat` (instance number, its mesh in world space).
-    pub fn build_flattening(bounds: &[Aabb], split: BvhSplit, flat: &[(u32, &TriangleMesh)]) -> TopLevelBvh {
-        let in_flat: std::collections::HashSet<u32> = flat.iter().map(|f| f.0).collect();
+    pub fn build_flattening(bounds: &[Aabb], split: BvhSplit, flat: &[FlatMesh]) -> TopLevelBvh {
+        let in_flat: std::collections::HashSet<u32> = flat.iter().map(|f| f.instance).collect();
         let rest: Vec<u32> = (0..bounds.len() as u32).filter(|i| !in_flat.contains(i)).collect();
         let rest_bounds: Vec<Aabb> = rest.iter().map(|&i| bounds[i as usize]).collect();
         let binary = Bvh::build(&rest_bounds, split);
@@ -49,7 +63,7 @@ impl TopLevelBvh {
             return top;
         }
         let mut offsets = vec![0u32];
-        for (_, m) in flat {
+        for m in flat {
             offsets.push(offsets.last().unwrap() + m.indices.len() as u32);
         }
         let locate = |g: u32| -> (usize, usize) {
@@ -59,7 +73,7 @@ impl TopLevelBvh {
         let tri_bounds: Vec<Aabb> = (0..*offsets.last().unwrap())
             .map(|g| {
                 let (k, t) = locate(g);
-                let [a, b, c] = flat[k].1.vertices(t);
+                let [a, b, c] = flat[k].vertices(t);
                 // Zero-area triangles cannot be hit: keep them out of the SAH's way.
                 if (b - a).cross(c - a).length_squared() == 0.0 {
                     Aabb::EMPTY
@@ -71,9 +85,9 @@ impl TopLevelBvh {
         let bvh = Bvh::build_with(&tri_bounds, split, BuildOptions::WIDE);
         top.flat = Some(TriangleWideBvh::build(&bvh, |g| {
             let (k, t) = locate(g);
-            flat[k].1.vertices(t)
+            flat[k].vertices(t)
         }));
-        top.flat_instances = flat.iter().map(|f| f.0).collect();
+        top.flat_instances = flat.iter().map(|f| f.instance).collect();
         top.flat_offsets = offsets;
         top
     }

@@ -6,7 +6,7 @@
 use super::{fresnel_dielectric, BsdfSample};
 use crate::math::{Rgb, Vec3, PI};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum MicrofacetKind {
     Ggx,
     Beckmann,

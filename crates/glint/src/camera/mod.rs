@@ -4,7 +4,7 @@
 use crate::math::{vec3, Ray, Transform, Vec3};
 use crate::sampling::warp;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum FovAxis {
     X,
     #[default]

@@ -267,8 +267,25 @@ pub fn cube_mesh(split: BvhSplit) -> TriangleMesh {
     TriangleMesh::new(positions, None, Some(uvs), indices, split).expect("valid cube")
 }
 
-/// Unit disk in the z = 0 plane facing +z, as a fan of `segments` triangles.
-pub fn disk_mesh(segments: u32, split: BvhSplit) -> TriangleMesh {
+/// The square [-1, 1]^2 in the z = 0 plane facing +z (Mitsuba's `rectangle`).
+pub fn rectangle_mesh(split: BvhSplit) -> TriangleMesh {
+    quad_mesh(
+        [
+            Vec3 { x: -1.0, y: -1.0, z: 0.0 },
+            Vec3 { x: 1.0, y: -1.0, z: 0.0 },
+            Vec3 { x: 1.0, y: 1.0, z: 0.0 },
+            Vec3 { x: -1.0, y: 1.0, z: 0.0 },
+        ],
+        split,
+    )
+}
+
+/// Triangles in the fan of a disk: every format's disk is this one mesh.
+pub const DISK_SEGMENTS: u32 = 256;
+
+/// Unit disk in the z = 0 plane facing +z, as a fan of [`DISK_SEGMENTS`] triangles.
+pub fn disk_mesh(split: BvhSplit) -> TriangleMesh {
+    let segments = DISK_SEGMENTS;
     let mut positions = vec![Vec3::ZERO];
     let mut uvs = vec![[0.5, 0.5]];
     for i in 0..segments {

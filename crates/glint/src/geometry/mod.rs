@@ -3,5 +3,7 @@
 mod mesh;
 mod sphere;
 
-pub use mesh::{cube_mesh, disk_mesh, quad_mesh, AccelStats, MeshAccel, TriangleMesh, WideTris};
+pub use mesh::{
+    cube_mesh, disk_mesh, quad_mesh, rectangle_mesh, AccelStats, MeshAccel, TriangleMesh, WideTris, DISK_SEGMENTS,
+};
 pub use sphere::Sphere;

@@ -1,18 +1,17 @@
 //! Integrators: estimate the radiance arriving along a camera ray.
 //!
 //! Each integrator has serialisable settings and a per-ray `li`; scheduling of pixels and
-//! threads lives in [`crate::render`], so integrators never see threads.
+//! threads lives in the render module, so integrators never see threads.
 
 mod path;
 mod whitted;
 
-pub use path::{PathSettings, Strategy};
-pub use whitted::WhittedSettings;
+pub use crate::describe::{PathSettings, Strategy, WhittedSettings};
 
 use crate::bsdf::Bsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::sampling::Sampler;
-use crate::scene::{Scene, SurfaceInteraction};
+use crate::world::{SurfaceInteraction, World};
 
 /// Per-thread counters, summed at the end of a render.
 #[derive(Clone, Copy, Debug, Default)]
@@ -27,6 +26,15 @@ pub enum Integrator {
     Path(PathSettings),
 }
 
+impl From<&crate::describe::IntegratorDesc> for Integrator {
+    fn from(d: &crate::describe::IntegratorDesc) -> Integrator {
+        match d {
+            crate::describe::IntegratorDesc::Whitted(w) => Integrator::Whitted(w.clone()),
+            crate::describe::IntegratorDesc::Path(p) => Integrator::Path(p.clone()),
+        }
+    }
+}
+
 impl Integrator {
     pub fn name(&self) -> &'static str {
         match self {
@@ -36,7 +44,7 @@ impl Integrator {
     }
 
     #[inline]
-    pub fn li(&self, scene: &Scene, ray: &Ray, rng: &mut Sampler, counters: &mut Counters) -> Rgb {
+    pub fn li(&self, scene: &World, ray: &Ray, rng: &mut Sampler, counters: &mut Counters) -> Rgb {
         match self {
             Integrator::Whitted(s) => whitted::li(s, scene, ray, rng, counters),
             Integrator::Path(s) => path::li(s, scene, ray, rng, counters),
@@ -47,7 +55,7 @@ impl Integrator {
 /// The BSDF at a hit and the frame to evaluate it in. Two-sided opaque materials turn
 /// their frame to face the viewer; one-sided ones (Mitsuba's default) keep it, so their back
 /// face is black; dielectrics keep it, since which side is inside matters to them.
-pub(crate) fn shading(scene: &Scene, si: &SurfaceInteraction, wo_world: Vec3) -> (Bsdf, Frame) {
+pub(crate) fn shading(scene: &World, si: &SurfaceInteraction, wo_world: Vec3) -> (Bsdf, Frame) {
     let mat = &scene.materials[si.material as usize];
     let bsdf = mat.bsdf(si.uv);
     let mut frame = si.frame;

@@ -4,63 +4,12 @@
 //! seen directly, 2 adds direct lighting, and so on.
 
 use super::{shading, shadow_ray, spawn_ray, Counters};
+use crate::describe::{PathSettings, Strategy};
 use crate::math::{Ray, Rgb};
 use crate::sampling::{power_heuristic, Sampler};
-use crate::scene::Scene;
-use serde::{Deserialize, Serialize};
+use crate::world::World;
 
-/// Which estimators contribute; all three converge to the same image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Strategy {
-    /// Light sampling and BSDF sampling combined by MIS (the default).
-    #[default]
-    Mis,
-    /// Light sampling only (emitters hit by BSDF rays count only after delta bounces).
-    Light,
-    /// BSDF sampling only (no shadow rays).
-    Bsdf,
-}
-
-impl std::str::FromStr for Strategy {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "mis" => Ok(Strategy::Mis),
-            "light" => Ok(Strategy::Light),
-            "bsdf" => Ok(Strategy::Bsdf),
-            _ => Err(format!("unknown strategy '{s}' (expected mis, light or bsdf)")),
-        }
-    }
-}
-
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct PathSettings {
-    /// Longest path in segments; `None` is unbounded.
-    pub max_depth: Option<u32>,
-    /// Depth (segments) from which Russian roulette may end paths.
-    pub rr_depth: u32,
-    /// A fixed survival probability (the paper's P) instead of the throughput-based one.
-    pub rr_probability: Option<f32>,
-    pub strategy: Strategy,
-    /// Do not show emitters seen directly by the camera.
-    pub hide_emitters: bool,
-}
-
-impl Default for PathSettings {
-    fn default() -> Self {
-        PathSettings {
-            max_depth: None,
-            rr_depth: 5,
-            rr_probability: None,
-            strategy: Strategy::Mis,
-            hide_emitters: false,
-        }
-    }
-}
-
-pub fn li(s: &PathSettings, scene: &Scene, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
+pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
     let max_depth = s.max_depth.unwrap_or(u32::MAX);
     if max_depth == 0 {
         return Rgb::BLACK;

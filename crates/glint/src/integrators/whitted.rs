@@ -5,30 +5,16 @@
 
 use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, Bsdf};
+use crate::describe::WhittedSettings;
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
-use crate::scene::Scene;
-use serde::{Deserialize, Serialize};
+use crate::world::World;
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct WhittedSettings {
-    pub max_depth: u32,
-    /// Radiance of rays that leave the scene (when no environment light is defined).
-    pub background: [f32; 3],
-}
-
-impl Default for WhittedSettings {
-    fn default() -> Self {
-        WhittedSettings { max_depth: 5, background: [0.0, 0.0, 0.0] }
-    }
-}
-
-pub fn li(s: &WhittedSettings, scene: &Scene, ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
+pub fn li(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
     trace(s, scene, ray, rng, c, 1)
 }
 
-fn trace(s: &WhittedSettings, scene: &Scene, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Rgb {
+fn trace(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Rgb {
     c.rays += 1;
     let Some(hit) = scene.intersect(ray) else {
         if scene.environment_lights.is_empty() {

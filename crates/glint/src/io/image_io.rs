@@ -140,10 +140,7 @@ pub fn read_image(path: &Path) -> Result<Image, String> {
     match ImageFormat::from_path(path)? {
         ImageFormat::Exr => read_exr(path),
         ImageFormat::Pfm => read_pfm(path),
-        ImageFormat::Png => {
-            let bm = crate::materials::Bitmap::load(path, false)?;
-            Ok(Image { width: bm.width, height: bm.height, pixels: bm.pixels })
-        }
+        ImageFormat::Png => super::read_texture_image(path, false),
     }
 }
 

@@ -3,5 +3,7 @@
 pub mod image_io;
 pub mod obj;
 pub mod ply;
+mod texture_file;
 
 pub use image_io::{read_image, write_image, Image};
+pub use texture_file::read_texture_image;

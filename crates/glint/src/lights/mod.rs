@@ -9,7 +9,9 @@
 //! hit by BSDF-sampled rays.
 
 mod envmap;
+mod selection;
 pub use envmap::EnvMap;
+pub use selection::LightSelection;
 
 use crate::geometry::Sphere;
 use crate::math::{Aabb, Frame, Rgb, Vec3, PI};

@@ -1,6 +1,6 @@
 //! Textures: a colour as a function of surface uv.
 
-use crate::math::{srgb_decode, Rgb};
+use crate::math::Rgb;
 use std::sync::Arc;
 
 /// An RGB image in linear space, sampled with bilinear filtering and wrap-around.
@@ -14,27 +14,8 @@ pub struct Bitmap {
 impl Bitmap {
     /// Loads PNG/JPEG (sRGB-decoded unless `raw`), EXR or HDR (linear).
     pub fn load(path: &std::path::Path, raw: bool) -> Result<Bitmap, String> {
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-        if ext == "exr" {
-            let img = crate::io::image_io::read_exr(path)?;
-            return Ok(Bitmap { width: img.width, height: img.height, pixels: img.pixels });
-        }
-        let img = image::open(path).map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
-        let linear_source = ext == "hdr";
-        let rgb = img.to_rgb32f();
-        let (w, h) = (rgb.width() as usize, rgb.height() as usize);
-        let pixels = rgb
-            .pixels()
-            .map(|p| {
-                let c = Rgb { r: p.0[0], g: p.0[1], b: p.0[2] };
-                if raw || linear_source {
-                    c
-                } else {
-                    c.map(srgb_decode)
-                }
-            })
-            .collect();
-        Ok(Bitmap { width: w, height: h, pixels })
+        let img = crate::io::read_texture_image(path, raw)?;
+        Ok(Bitmap { width: img.width, height: img.height, pixels: img.pixels })
     }
 
     #[inline]

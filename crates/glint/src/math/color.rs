@@ -3,7 +3,7 @@
 
 use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Sub};
 
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Rgb {
     pub r: f32,
     pub g: f32,

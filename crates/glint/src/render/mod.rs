@@ -3,14 +3,13 @@
 //! and each pixel sums its samples in order, so the image is bit-identical whatever the
 //! number of threads.
 
-mod filter;
-pub use filter::PixelFilter;
+pub use crate::sampling::PixelFilter;
 
 use crate::integrators::{Counters, Integrator};
 use crate::io::Image;
 use crate::math::Rgb;
 use crate::sampling::{Sampler, SamplerKind};
-use crate::scene::Scene;
+use crate::world::World;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -79,7 +78,7 @@ struct Tile {
 }
 
 pub fn render(
-    scene: &Scene,
+    scene: &World,
     integrator: &Integrator,
     settings: &RenderSettings,
     progress: &dyn Progress,

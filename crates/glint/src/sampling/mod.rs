@@ -1,11 +1,13 @@
 //! Random numbers, warps from the unit square, and discrete distributions.
 
 mod distribution;
+mod filter;
 mod rng;
 mod sampler;
 pub mod warp;
 
 pub use distribution::{DiscreteSample, Distribution1d};
+pub use filter::PixelFilter;
 pub use rng::{mix64, Rng};
 pub use sampler::{Sampler, SamplerKind};
 

@@ -15,7 +15,7 @@ use super::{mix64, Rng};
 /// Requests per sample served by Sobol points; deep path vertices use PCG32 numbers.
 const SOBOL_DIMENSIONS: u32 = 64;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum SamplerKind {
     Independent,
     #[default]

@@ -3,5 +3,6 @@
 
 pub mod analytic;
 pub mod bsdf_check;
+pub mod load;
 pub mod scenes;
 pub mod stats;

@@ -2,14 +2,17 @@
 
 use glint::accel::BvhSplit;
 use glint::bsdf::{Microfacet, MicrofacetKind};
+use glint::build::WorldBuilder;
 use glint::camera::{Camera, FovAxis};
+use glint::describe::Emission;
 use glint::geometry::{cube_mesh, quad_mesh};
 use glint::integrators::{Integrator, PathSettings, Strategy};
+use glint::lights::LightSelection;
 use glint::materials::{Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::render::{render, PixelFilter, RenderOutput, RenderSettings, Silent};
 use glint::sampling::SamplerKind;
-use glint::scene::{Emission, LightSelection, Scene, SceneBuilder};
+use glint::world::World;
 use std::sync::Arc;
 
 pub fn camera(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, width: u32, height: u32) -> Camera {
@@ -36,7 +39,7 @@ pub fn path(strategy: Strategy) -> Integrator {
     Integrator::Path(PathSettings { strategy, ..PathSettings::default() })
 }
 
-pub fn render_with(scene: &Scene, integrator: &Integrator, spp: u32, seed: u64) -> RenderOutput {
+pub fn render_with(scene: &World, integrator: &Integrator, spp: u32, seed: u64) -> RenderOutput {
     let out = render(scene, integrator, &settings(spp, seed), &Silent);
     assert_eq!(out.stats.discarded_samples, 0, "the renderer produced NaN, infinite or negative samples");
     out
@@ -47,17 +50,17 @@ pub fn emission(radiance: f32) -> Option<Emission> {
 }
 
 /// A diffuse material, scattering on both faces.
-pub fn diffuse(b: &mut SceneBuilder, name: &str, albedo: Rgb) -> u32 {
+pub fn diffuse(b: &mut WorldBuilder, name: &str, albedo: Rgb) -> u32 {
     b.add_material(Material::new(name, MaterialKind::Diffuse { reflectance: Texture::Constant(albedo) }, true))
 }
 
-pub fn black(b: &mut SceneBuilder) -> u32 {
+pub fn black(b: &mut WorldBuilder) -> u32 {
     b.black_material()
 }
 
 /// A GGX metal with reflectance 1 at every angle (eta 0, k 1), so that only the microfacet
 /// model shapes the lobe.
-pub fn rough_mirror(b: &mut SceneBuilder, name: &str, alpha: f32) -> u32 {
+pub fn rough_mirror(b: &mut WorldBuilder, name: &str, alpha: f32) -> u32 {
     b.add_material(Material::new(
         name,
         MaterialKind::RoughConductor {
@@ -72,7 +75,7 @@ pub fn rough_mirror(b: &mut SceneBuilder, name: &str, alpha: f32) -> u32 {
 
 /// The quad p0 p1 p2 p3; its face (and, when it emits, its emission) points along
 /// (p1 - p0) × (p2 - p0).
-pub fn add_quad(b: &mut SceneBuilder, p: [Vec3; 4], material: u32, emission: Option<Emission>) {
+pub fn add_quad(b: &mut WorldBuilder, p: [Vec3; 4], material: u32, emission: Option<Emission>) {
     let mesh = Arc::new(quad_mesh(p, BvhSplit::Sah));
     b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, material, emission, false).unwrap();
 }
@@ -80,7 +83,7 @@ pub fn add_quad(b: &mut SceneBuilder, p: [Vec3; 4], material: u32, emission: Opt
 /// An axis-aligned square of half-size `half` centred at `c` in the plane normal to `axis`
 /// (0, 1, 2), facing `+axis` if `sign > 0`.
 pub fn add_square(
-    b: &mut SceneBuilder,
+    b: &mut WorldBuilder,
     c: Vec3,
     axis: usize,
     sign: f32,
@@ -103,7 +106,7 @@ pub fn add_square(
 }
 
 /// A box `[-1, 1]³` scaled, rotated about y and moved.
-pub fn add_box(b: &mut SceneBuilder, size: Vec3, rotate_y: f32, at: Vec3, material: u32) {
+pub fn add_box(b: &mut WorldBuilder, size: Vec3, rotate_y: f32, at: Vec3, material: u32) {
     let xf = Transform::translate(at)
         .then_after(&Transform::rotate(Vec3::Y, rotate_y))
         .then_after(&Transform::scale(size).unwrap());
@@ -112,13 +115,13 @@ pub fn add_box(b: &mut SceneBuilder, size: Vec3, rotate_y: f32, at: Vec3, materi
 
 /// A Cornell-like box: white floor, ceiling and back wall, red left and green right walls,
 /// two white boxes and a small square light under the ceiling. Open at the front.
-pub fn cornell_box(width: u32, height: u32) -> Scene {
+pub fn cornell_box(width: u32, height: u32) -> World {
     cornell_box_with(width, height, |_| {})
 }
 
 /// The Cornell-like box with more objects added by `extra`.
-pub fn cornell_box_with(width: u32, height: u32, extra: impl FnOnce(&mut SceneBuilder)) -> Scene {
-    let mut b = SceneBuilder::new(BvhSplit::Sah);
+pub fn cornell_box_with(width: u32, height: u32, extra: impl FnOnce(&mut WorldBuilder)) -> World {
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
     let white = diffuse(&mut b, "white", Rgb::splat(0.73));
     let red = diffuse(&mut b, "red", Rgb { r: 0.63, g: 0.065, b: 0.05 });
     let green = diffuse(&mut b, "green", Rgb { r: 0.14, g: 0.45, b: 0.09 });

@@ -4,6 +4,7 @@
 //! be reported instead of silently ignored.
 
 use super::xml::Element;
+use crate::error::Error;
 use crate::math::{Mat4, Rgb, Transform, Vec3};
 use std::cell::RefCell;
 use std::collections::HashSet;
@@ -13,18 +14,18 @@ pub struct Props<'a> {
     used: RefCell<HashSet<String>>,
 }
 
-pub fn parse_floats(el: &Element, s: &str) -> Result<Vec<f32>, String> {
+pub fn parse_floats(el: &Element, s: &str) -> Result<Vec<f32>, Error> {
     s.split(|c: char| c == ',' || c.is_whitespace())
         .filter(|t| !t.is_empty())
         .map(|t| t.parse::<f32>().map_err(|_| el.err(format!("'{t}' is not a number"))))
         .collect()
 }
 
-pub fn parse_float(el: &Element, s: &str) -> Result<f32, String> {
+pub fn parse_float(el: &Element, s: &str) -> Result<f32, Error> {
     s.trim().parse::<f32>().map_err(|_| el.err(format!("'{s}' is not a number")))
 }
 
-fn parse_vec3(el: &Element) -> Result<Vec3, String> {
+fn parse_vec3(el: &Element) -> Result<Vec3, Error> {
     if let Some(v) = el.attr("value") {
         let f = parse_floats(el, v)?;
         return match f.len() {
@@ -51,7 +52,7 @@ impl<'a> Props<'a> {
         found
     }
 
-    pub fn float(&self, name: &str, default: f32) -> Result<f32, String> {
+    pub fn float(&self, name: &str, default: f32) -> Result<f32, Error> {
         match self.find(name) {
             None => Ok(default),
             Some(e) if matches!(e.tag.as_str(), "float" | "integer") => parse_float(e, e.required("value")?),
@@ -59,11 +60,11 @@ impl<'a> Props<'a> {
         }
     }
 
-    pub fn opt_float(&self, name: &str) -> Result<Option<f32>, String> {
+    pub fn opt_float(&self, name: &str) -> Result<Option<f32>, Error> {
         Ok(if self.find(name).is_some() { Some(self.float(name, 0.0)?) } else { None })
     }
 
-    pub fn int(&self, name: &str, default: i64) -> Result<i64, String> {
+    pub fn int(&self, name: &str, default: i64) -> Result<i64, Error> {
         match self.find(name) {
             None => Ok(default),
             Some(e) => {
@@ -73,7 +74,7 @@ impl<'a> Props<'a> {
         }
     }
 
-    pub fn bool(&self, name: &str, default: bool) -> Result<bool, String> {
+    pub fn bool(&self, name: &str, default: bool) -> Result<bool, Error> {
         match self.find(name) {
             None => Ok(default),
             Some(e) => match e.required("value")? {
@@ -89,14 +90,14 @@ impl<'a> Props<'a> {
     }
 
     /// A colour from `<rgb>`, a constant `<spectrum>` or a `<float>`.
-    pub fn rgb(&self, name: &str, default: Rgb) -> Result<Rgb, String> {
+    pub fn rgb(&self, name: &str, default: Rgb) -> Result<Rgb, Error> {
         match self.find(name) {
             None => Ok(default),
             Some(e) => color_of(e),
         }
     }
 
-    pub fn point(&self, name: &str) -> Result<Option<Vec3>, String> {
+    pub fn point(&self, name: &str) -> Result<Option<Vec3>, Error> {
         match self.find(name) {
             None => Ok(None),
             Some(e) if matches!(e.tag.as_str(), "point" | "vector") => Ok(Some(parse_vec3(e)?)),
@@ -104,7 +105,7 @@ impl<'a> Props<'a> {
         }
     }
 
-    pub fn transform(&self, name: &str) -> Result<Transform, String> {
+    pub fn transform(&self, name: &str) -> Result<Transform, Error> {
         match self.find(name) {
             None => Ok(Transform::IDENTITY),
             Some(e) if e.tag == "transform" => transform_of(e),
@@ -125,7 +126,7 @@ impl<'a> Props<'a> {
     }
 }
 
-pub fn color_of(e: &Element) -> Result<Rgb, String> {
+pub fn color_of(e: &Element) -> Result<Rgb, Error> {
     match e.tag.as_str() {
         "rgb" => {
             let f = parse_floats(e, e.required("value")?)?;
@@ -153,7 +154,7 @@ pub fn color_of(e: &Element) -> Result<Rgb, String> {
 
 /// Composes the operations of a `<transform>` in document order (each applies after the
 /// ones before it), as Mitsuba does.
-pub fn transform_of(el: &Element) -> Result<Transform, String> {
+pub fn transform_of(el: &Element) -> Result<Transform, Error> {
     let mut t = Transform::IDENTITY;
     for op in &el.children {
         let step = match op.tag.as_str() {
@@ -195,7 +196,7 @@ pub fn transform_of(el: &Element) -> Result<Transform, String> {
                 Transform::from_matrix(Mat4(m)).ok_or_else(|| op.err("the matrix is not invertible"))?
             }
             "lookat" => {
-                let v = |k: &str| -> Result<Vec3, String> {
+                let v = |k: &str| -> Result<Vec3, Error> {
                     let f = parse_floats(op, op.required(k)?)?;
                     if f.len() != 3 {
                         return Err(op.err(format!("'{k}' needs 3 numbers")));

@@ -1,27 +1,22 @@
-//! The one path from any scene description (native JSON, Mitsuba XML) to the render-ready
-//! [`Scene`]: loaders call these methods, which validate, load meshes once, fold transforms
-//! and create area lights.
+//! The world builder: places meshes, spheres, materials and lights, loads each mesh file
+//! once, folds transforms and creates area lights. `build` drives it from a description;
+//! tests drive it directly to make small worlds in code.
 
-use super::world::{Instance, LightSelection, Scene, ShapeRef};
 use crate::accel::BvhSplit;
 use crate::camera::Camera;
+use crate::describe::Emission;
 use crate::geometry::{Sphere, TriangleMesh};
 use crate::io::{obj, ply};
+use crate::lights::LightSelection;
 use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
 use crate::math::{Aabb, Rgb, Transform, Vec3};
 use crate::sampling::Distribution1d;
+use crate::world::{Instance, ShapeRef, World};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
-
-/// An area emitter attached to a shape.
-#[derive(Clone, Copy, Debug)]
-pub struct Emission {
-    pub radiance: Rgb,
-    pub two_sided: bool,
-}
 
 /// Lights that need the finished scene's bounds, created in `finish`.
 enum PendingLight {
@@ -37,9 +32,58 @@ pub struct LoadedGroup {
     pub mesh: Arc<TriangleMesh>,
     /// `usemtl` name for OBJ groups, empty otherwise.
     pub material: String,
+    /// That material as the OBJ's MTL file defines it, if it does.
+    pub mtl: Option<obj::MtlMaterial>,
 }
 
-pub struct SceneBuilder {
+impl LoadedGroup {
+    pub fn primitive(mesh: TriangleMesh) -> LoadedGroup {
+        LoadedGroup { mesh: Arc::new(mesh), material: String::new(), mtl: None }
+    }
+}
+
+/// Reads an OBJ (one group per material) or PLY file and builds each group's BVH.
+pub fn read_mesh_file(path: &Path, face_normals: bool, split: BvhSplit) -> Result<Vec<LoadedGroup>, String> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "obj" => {
+            let f = obj::read_obj(path)?;
+            let mut out = Vec::new();
+            for g in f.groups {
+                let normals = if face_normals { None } else { g.normals };
+                let mesh = TriangleMesh::new(g.positions, normals, g.uvs, g.indices, split)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                let mtl = f.materials.iter().find(|m| m.name == g.material).cloned();
+                out.push(LoadedGroup { mesh: Arc::new(mesh), material: g.material, mtl });
+            }
+            Ok(out)
+        }
+        "ply" => {
+            let m = ply::read_ply(path)?;
+            let normals = if face_normals { None } else { m.normals };
+            let mesh = TriangleMesh::new(m.positions, normals, m.uvs, m.indices, split)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            Ok(vec![LoadedGroup::primitive(mesh)])
+        }
+        _ => Err(format!("{}: unknown mesh format (expected .obj or .ply)", path.display())),
+    }
+}
+
+/// Material for an MTL entry (used when an OBJ shape names no material).
+fn material_from_mtl(m: &obj::MtlMaterial) -> Material {
+    let kind = if m.illum == 7 || m.dissolve < 1.0 {
+        MaterialKind::Dielectric { eta: m.ni.max(1.0001), reflect: Rgb::WHITE, transmit: Rgb::WHITE }
+    } else if m.illum == 5 {
+        MaterialKind::Conductor { eta: Rgb::BLACK, k: Rgb::WHITE, specular: m.ks }
+    } else if m.ks.max_component() > 0.0 && m.ns > 0.0 {
+        MaterialKind::Phong { kd: Texture::Constant(m.kd), ks: m.ks, exponent: m.ns }
+    } else {
+        MaterialKind::Diffuse { reflectance: Texture::Constant(m.kd) }
+    };
+    Material::new(format!("mtl:{}", m.name), kind, true)
+}
+
+pub struct WorldBuilder {
     pub split: BvhSplit,
     meshes: Vec<Arc<TriangleMesh>>,
     spheres: Vec<Sphere>,
@@ -47,15 +91,13 @@ pub struct SceneBuilder {
     materials: Vec<Material>,
     material_names: HashMap<String, u32>,
     lights: Vec<PendingLight>,
-    file_cache: HashMap<PathBuf, Vec<LoadedGroup>>,
     mesh_ids: HashMap<*const TriangleMesh, u32>,
-    pub mtl_materials: HashMap<String, obj::MtlMaterial>,
     pub build_seconds: f64,
 }
 
-impl SceneBuilder {
-    pub fn new(split: BvhSplit) -> SceneBuilder {
-        SceneBuilder {
+impl WorldBuilder {
+    pub fn new(split: BvhSplit) -> WorldBuilder {
+        WorldBuilder {
             split,
             meshes: Vec::new(),
             spheres: Vec::new(),
@@ -63,9 +105,7 @@ impl SceneBuilder {
             materials: Vec::new(),
             material_names: HashMap::new(),
             lights: Vec::new(),
-            file_cache: HashMap::new(),
             mesh_ids: HashMap::new(),
-            mtl_materials: HashMap::new(),
             build_seconds: 0.0,
         }
     }
@@ -101,45 +141,15 @@ impl SceneBuilder {
         ))
     }
 
-    /// Loads an OBJ or PLY file (once per path), transformed by `to_world` baked into the
-    /// vertices unless `instanced` (then the mesh stays in object space for sharing).
-    pub fn load_mesh_file(&mut self, path: &Path, face_normals: bool) -> Result<Vec<LoadedGroup>, String> {
-        if let Some(g) = self.file_cache.get(path) {
-            return Ok(g.clone());
+    /// The material of an OBJ group's `usemtl` entry (created on first use), if the MTL
+    /// file defines it.
+    pub fn mtl_material(&mut self, group: &LoadedGroup) -> Option<u32> {
+        let mtl = group.mtl.as_ref()?;
+        let key = format!("mtl:{}", mtl.name);
+        if let Some(id) = self.material_id(&key) {
+            return Some(id);
         }
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-        let mut build = 0.0;
-        let groups = match ext.as_str() {
-            "obj" => {
-                let f = obj::read_obj(path)?;
-                for m in f.materials {
-                    self.mtl_materials.insert(m.name.clone(), m);
-                }
-                let mut out = Vec::new();
-                for g in f.groups {
-                    let normals = if face_normals { None } else { g.normals };
-                    let start = Instant::now();
-                    let mesh = TriangleMesh::new(g.positions, normals, g.uvs, g.indices, self.split)
-                        .map_err(|e| format!("{}: {e}", path.display()))?;
-                    build += start.elapsed().as_secs_f64();
-                    out.push(LoadedGroup { mesh: Arc::new(mesh), material: g.material });
-                }
-                out
-            }
-            "ply" => {
-                let m = ply::read_ply(path)?;
-                let normals = if face_normals { None } else { m.normals };
-                let start = Instant::now();
-                let mesh = TriangleMesh::new(m.positions, normals, m.uvs, m.indices, self.split)
-                    .map_err(|e| format!("{}: {e}", path.display()))?;
-                build += start.elapsed().as_secs_f64();
-                vec![LoadedGroup { mesh: Arc::new(mesh), material: String::new() }]
-            }
-            _ => return Err(format!("{}: unknown mesh format (expected .obj or .ply)", path.display())),
-        };
-        self.build_seconds += build;
-        self.file_cache.insert(path.to_path_buf(), groups.clone());
-        Ok(groups)
+        Some(self.add_material(material_from_mtl(mtl)))
     }
 
     fn mesh_id(&mut self, mesh: &Arc<TriangleMesh>) -> u32 {
@@ -284,7 +294,12 @@ impl SceneBuilder {
         self.instances.len()
     }
 
-    pub fn finish(self, camera: Camera, selection: LightSelection) -> Result<Scene, String> {
+    /// The bounds of everything placed so far.
+    pub fn bounds(&self) -> Aabb {
+        self.instances.iter().fold(Aabb::EMPTY, |a, i| a.union(i.bounds))
+    }
+
+    pub fn finish(self, camera: Camera, selection: LightSelection) -> Result<World, String> {
         let start = Instant::now();
         let bounds = self.instances.iter().fold(Aabb::EMPTY, |a, i| a.union(i.bounds));
         let radius = scene_radius(&bounds);
@@ -306,7 +321,7 @@ impl SceneBuilder {
             }
             lights.push(light);
         }
-        let mut scene = Scene {
+        let mut scene = World {
             meshes: self.meshes,
             spheres: self.spheres,
             instances: self.instances,

@@ -5,7 +5,7 @@
 
 use crate::math::PI;
 
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub enum PixelFilter {
     /// Uniform over the pixel.
     #[default]

@@ -1,14 +1,16 @@
-//! The render-ready scene: geometry in a two-level BVH, materials, lights and the camera.
+//! The render-ready world: geometry in a two-level BVH, materials, lights and the camera,
+//! built from a scene description by `build` (the only module that creates one). Its fields
+//! are private to the crate: front ends read it through the accessors below.
 //!
 //! Bottom level: one BVH per mesh, in the mesh's own space. Top level: a BVH over
 //! instances, each a reference to a shape with its own transform, so a mesh placed many times
 //! costs its memory once. Traversal returns a cheap [`Hit`]; the full
 //! [`SurfaceInteraction`] is computed only for the hit that is shaded.
 
-use crate::accel::{BvhSplit, TopLevelBvh};
+use crate::accel::{BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{Sphere, TriangleMesh};
-use crate::lights::Light;
+use crate::lights::{Light, LightSelection};
 use crate::materials::Material;
 use crate::math::{Aabb, Frame, Ray, Transform, Vec3};
 use crate::sampling::Distribution1d;
@@ -57,60 +59,39 @@ pub struct SurfaceInteraction {
     pub t: f32,
 }
 
-/// How the integrators choose which light to sample.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum LightSelection {
-    Uniform,
-    /// Proportional to area (the paper's choice); non-area lights get the mean weight.
-    Area,
-    /// Proportional to emitted power among bounded lights; each infinite light (sky,
-    /// environment map, directional) is chosen as often as all bounded lights together.
-    #[default]
-    Power,
-}
-
-impl std::str::FromStr for LightSelection {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "uniform" => Ok(LightSelection::Uniform),
-            "area" => Ok(LightSelection::Area),
-            "power" => Ok(LightSelection::Power),
-            _ => Err(format!("unknown light selection '{s}' (expected uniform, area or power)")),
-        }
-    }
-}
-
-pub struct Scene {
-    pub meshes: Vec<Arc<TriangleMesh>>,
-    pub spheres: Vec<Sphere>,
-    pub instances: Vec<Instance>,
+pub struct World {
+    pub(crate) meshes: Vec<Arc<TriangleMesh>>,
+    pub(crate) spheres: Vec<Sphere>,
+    pub(crate) instances: Vec<Instance>,
     /// Over instances: the binary reference and the 8-wide tree that traversal uses.
-    pub top: TopLevelBvh,
-    pub materials: Vec<Material>,
-    pub lights: Vec<Light>,
+    pub(crate) top: TopLevelBvh,
+    pub(crate) materials: Vec<Material>,
+    pub(crate) lights: Vec<Light>,
     /// Indices of infinite lights that a escaping ray sees (constant, envmap).
-    pub environment_lights: Vec<u32>,
-    pub camera: Camera,
-    pub bounds: Aabb,
-    pub light_distribution: Option<Distribution1d>,
-    pub light_selection: LightSelection,
-    pub bvh_split: BvhSplit,
-    pub bvh_build_seconds: f64,
+    pub(crate) environment_lights: Vec<u32>,
+    pub(crate) camera: Camera,
+    pub(crate) bounds: Aabb,
+    pub(crate) light_distribution: Option<Distribution1d>,
+    pub(crate) light_selection: LightSelection,
+    pub(crate) bvh_split: BvhSplit,
+    pub(crate) bvh_build_seconds: f64,
 }
 
-impl Scene {
+impl World {
     /// Builds the top-level BVH and the light-selection distribution. Called once by the
     /// scene builder after all instances and lights are in place.
-    pub fn finish(&mut self, selection: LightSelection) {
+    pub(crate) fn finish(&mut self, selection: LightSelection) {
         let boxes: Vec<Aabb> = self.instances.iter().map(|i| i.bounds).collect();
         // Untransformed mesh instances go into one merged triangle BVH (see TopLevelBvh).
-        let flat: Vec<(u32, &TriangleMesh)> = self
+        let flat: Vec<FlatMesh> = self
             .instances
             .iter()
             .enumerate()
             .filter_map(|(i, inst)| match (inst.shape, &inst.to_world) {
-                (ShapeRef::Mesh(m), None) => Some((i as u32, &*self.meshes[m as usize])),
+                (ShapeRef::Mesh(m), None) => {
+                    let mesh = &self.meshes[m as usize];
+                    Some(FlatMesh { instance: i as u32, positions: &mesh.positions, indices: &mesh.indices })
+                }
                 _ => None,
             })
             .collect();
@@ -321,6 +302,41 @@ impl Scene {
             light: inst.light,
             t: hit.t,
         }
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+    pub fn meshes(&self) -> &[Arc<TriangleMesh>] {
+        &self.meshes
+    }
+    pub fn spheres(&self) -> &[Sphere] {
+        &self.spheres
+    }
+    pub fn instances(&self) -> &[Instance] {
+        &self.instances
+    }
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+    pub fn top_level(&self) -> &TopLevelBvh {
+        &self.top
+    }
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+    pub fn light_selection(&self) -> LightSelection {
+        self.light_selection
+    }
+    pub fn bvh_split(&self) -> BvhSplit {
+        self.bvh_split
+    }
+    /// Seconds spent building BVHs (meshes and the top level) for this world.
+    pub fn bvh_build_seconds(&self) -> f64 {
+        self.bvh_build_seconds
     }
 
     pub fn triangle_count(&self) -> usize {

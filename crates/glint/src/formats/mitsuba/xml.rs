@@ -3,9 +3,16 @@
 //! for Mitsuba 0.x get the renames Mitsuba 3 itself applies (camelCase parameter names to
 //! snake_case, `lookAt` to `lookat`, `srgb` to `rgb`).
 
+use crate::error::{Error, SourceLoc};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// The deepest element nesting read (deeper files are refused, not recursed into).
+pub const MAX_DEPTH: usize = 256;
+/// The most `<include>`s one scene may expand, in all (a file included by many files that
+/// include each other grows without bound otherwise).
+pub const MAX_INCLUDES: usize = 1000;
 
 #[derive(Clone, Debug)]
 pub struct Element {
@@ -14,59 +21,81 @@ pub struct Element {
     pub children: Vec<Element>,
     pub file: Arc<PathBuf>,
     pub line: usize,
+    pub col: usize,
 }
 
 impl Element {
     pub fn attr(&self, name: &str) -> Option<&str> {
         self.attrs.iter().find(|(k, _)| k == name).map(|(_, v)| v.as_str())
     }
-    /// "file:line: message".
-    pub fn err(&self, msg: impl std::fmt::Display) -> String {
-        format!("{}:{}: {}", self.file.display(), self.line, msg)
+    pub fn loc(&self) -> SourceLoc {
+        SourceLoc::new(self.file.as_path(), self.line as u32, self.col as u32)
     }
-    pub fn required(&self, name: &str) -> Result<&str, String> {
+    /// An error at this element ("file:line:col: message").
+    pub fn err(&self, msg: impl std::fmt::Display) -> Error {
+        Error::at(&self.loc(), msg.to_string())
+    }
+    pub fn required(&self, name: &str) -> Result<&str, Error> {
         self.attr(name).ok_or_else(|| self.err(format!("<{}> needs a '{name}' attribute", self.tag)))
     }
 }
 
 /// Parses one file into its root element (no includes or substitution yet).
-fn parse_file(path: &Path) -> Result<Element, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+fn parse_file(path: &Path) -> Result<Element, Error> {
+    let text = crate::formats::read_text(path)?;
     parse_str(&text, path)
 }
 
-pub fn parse_str(text: &str, path: &Path) -> Result<Element, String> {
+pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
     use quick_xml::events::Event;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let file = Arc::new(path.to_path_buf());
     let line_starts: Vec<usize> = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
     let line_at = |pos: usize| line_starts.partition_point(|&s| s <= pos);
+    let loc_at = |pos: usize| {
+        let line = line_at(pos);
+        let col = text.get(line_starts[line - 1]..pos.min(text.len())).map_or(0, |t| t.chars().count() + 1);
+        SourceLoc::new(path, line as u32, col as u32)
+    };
     let mut reader = quick_xml::Reader::from_str(text);
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
     loop {
         let before = reader.buffer_position() as usize;
-        let ev = reader.read_event().map_err(|e| {
-            format!("{}:{}: malformed XML: {e}", path.display(), line_at(reader.error_position() as usize))
-        })?;
+        let ev = reader
+            .read_event()
+            .map_err(|e| Error::at(&loc_at(reader.error_position() as usize), format!("malformed XML: {e}")))?;
         // The event starts at the first '<' after the previous event.
         let start = text[before..].find('<').map_or(before, |o| before + o);
-        let make = |e: &quick_xml::events::BytesStart| -> Result<Element, String> {
+        let make = |e: &quick_xml::events::BytesStart| -> Result<Element, Error> {
             let tag = String::from_utf8_lossy(e.name().as_ref()).to_string();
             let mut attrs = Vec::new();
             for a in e.attributes() {
-                let a =
-                    a.map_err(|err| format!("{}:{}: malformed attribute: {err}", path.display(), line_at(start)))?;
+                let a = a.map_err(|err| Error::at(&loc_at(start), format!("malformed attribute: {err}")))?;
                 let key = String::from_utf8_lossy(a.key.as_ref()).to_string();
                 let value = a
                     .unescape_value()
-                    .map_err(|err| format!("{}:{}: malformed attribute: {err}", path.display(), line_at(start)))?
+                    .map_err(|err| Error::at(&loc_at(start), format!("malformed attribute: {err}")))?
                     .to_string();
                 attrs.push((key, value));
             }
-            Ok(Element { tag, attrs, children: Vec::new(), file: file.clone(), line: line_at(start) })
+            let loc = loc_at(start);
+            Ok(Element {
+                tag,
+                attrs,
+                children: Vec::new(),
+                file: file.clone(),
+                line: loc.line as usize,
+                col: loc.col as usize,
+            })
         };
         match ev {
-            Event::Start(e) => stack.push(make(&e)?),
+            Event::Start(e) => {
+                if stack.len() >= MAX_DEPTH {
+                    return Err(Error::at(&loc_at(start), format!("elements nested more than {MAX_DEPTH} deep")));
+                }
+                stack.push(make(&e)?)
+            }
             Event::Empty(e) => {
                 let el = make(&e)?;
                 match stack.last_mut() {
@@ -75,7 +104,9 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, String> {
                 }
             }
             Event::End(_) => {
-                let el = stack.pop().expect("quick-xml checks nesting");
+                let Some(el) = stack.pop() else {
+                    return Err(Error::at(&loc_at(start), "malformed XML: a closing tag without an opening one"));
+                };
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(el),
                     None => root = Some(el),
@@ -85,22 +116,25 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, String> {
             Event::Text(t) => {
                 let s = String::from_utf8_lossy(t.as_ref()).to_string();
                 if !s.trim().is_empty() {
-                    return Err(format!("{}:{}: unexpected text '{}'", path.display(), line_at(start), s.trim()));
+                    // Reported where the text itself starts, not at the next tag.
+                    let lead = s.len() - s.trim_start().len();
+                    return Err(Error::at(&loc_at(before + lead), format!("unexpected text '{}'", s.trim())));
                 }
             }
             _ => {}
         }
     }
-    if !stack.is_empty() {
-        return Err(format!("{}:{}: malformed XML: <{}> is never closed", path.display(), stack[0].line, stack[0].tag));
+    if let Some(open) = stack.first() {
+        return Err(open.err(format!("malformed XML: <{}> is never closed", open.tag)));
     }
-    root.ok_or_else(|| format!("{}: empty XML document", path.display()))
+    root.ok_or_else(|| Error::at(&SourceLoc::file(path), "empty XML document"))
 }
 
 /// Loads a scene file: parses it, expands includes, applies version upgrades, collects
 /// defaults (overridden by `defines`) and substitutes `$name` references.
-pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, String> {
+pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, Error> {
     let mut root = parse_file(path)?;
+    let mut includes = 0usize;
     if root.tag != "scene" {
         return Err(root.err(format!("the root element is <{}>, expected <scene>", root.tag)));
     }
@@ -113,7 +147,7 @@ pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, S
     if major > 3 {
         return Err(root.err(format!("scene version {version} is newer than the 3.x that glint reads")));
     }
-    expand_includes(&mut root, 0)?;
+    expand_includes(&mut root, 0, &mut includes)?;
     if major < 2 {
         upgrade_from_v0(&mut root);
     }
@@ -135,27 +169,31 @@ pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, S
     Ok(root)
 }
 
-fn expand_includes(el: &mut Element, depth: usize) -> Result<(), String> {
+fn expand_includes(el: &mut Element, depth: usize, includes: &mut usize) -> Result<(), Error> {
     if depth > 16 {
         return Err(el.err("includes nested more than 16 deep (a cycle?)"));
     }
     let mut out = Vec::with_capacity(el.children.len());
     for mut c in std::mem::take(&mut el.children) {
         if c.tag == "include" {
+            *includes += 1;
+            if *includes > MAX_INCLUDES {
+                return Err(c.err(format!("more than {MAX_INCLUDES} <include>s in one scene")));
+            }
             let name = c.required("filename")?;
             let path = c.file.parent().unwrap_or(Path::new(".")).join(name);
             if !path.exists() {
                 return Err(c.err(format!("included file '{}' does not exist", path.display())));
             }
             let mut inc = parse_file(&path)?;
-            expand_includes(&mut inc, depth + 1)?;
+            expand_includes(&mut inc, depth + 1, includes)?;
             if inc.tag == "scene" {
                 out.extend(inc.children);
             } else {
                 out.push(inc);
             }
         } else {
-            expand_includes(&mut c, depth)?;
+            expand_includes(&mut c, depth, includes)?;
             out.push(c);
         }
     }
@@ -231,20 +269,33 @@ fn upgrade_from_v0(el: &mut Element) {
     }
 }
 
-fn substitute(el: &mut Element, values: &HashMap<String, String>) -> Result<(), String> {
+/// Replaces each `$name` by its value, once: the output is not scanned again, so a value
+/// that mentions `$name` (or a default defined as itself) cannot loop.
+fn substitute(el: &mut Element, values: &HashMap<String, String>) -> Result<(), Error> {
+    let loc = el.loc();
     for (_, v) in el.attrs.iter_mut() {
-        while let Some(i) = v.find('$') {
-            let rest = &v[i + 1..];
-            let len = rest.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(rest.len());
-            let name = &rest[..len];
-            if name.is_empty() {
-                break;
-            }
-            let value = values.get(name).ok_or_else(|| {
-                format!("{}:{}: ${name} has no <default> and no -D {name}=...", el.file.display(), el.line)
-            })?;
-            *v = format!("{}{}{}", &v[..i], value, &rest[len..]);
+        if !v.contains('$') {
+            continue;
         }
+        let mut out = String::with_capacity(v.len());
+        let mut rest = v.as_str();
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let after = &rest[i + 1..];
+            let len = after.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(after.len());
+            let name = &after[..len];
+            if name.is_empty() {
+                out.push('$');
+            } else {
+                let value = values
+                    .get(name)
+                    .ok_or_else(|| Error::at(&loc, format!("${name} has no <default> and no -D {name}=...")))?;
+                out.push_str(value);
+            }
+            rest = &after[len..];
+        }
+        out.push_str(rest);
+        *v = out;
     }
     for c in el.children.iter_mut() {
         substitute(c, values)?;

@@ -1,26 +1,26 @@
-//! Mitsuba 3 scene XML. `xml` reads the file into a tree (includes, defaults, `$name`
-//! substitution, 0.x upgrades), `props` reads typed parameters, and this module maps each
-//! plugin onto the [`SceneBuilder`]. What glint supports, plugin by plugin and parameter by
-//! parameter, is listed in docs/mitsuba-support.md; anything else is an error that names the
-//! plugin, the file and the line.
+//! Mitsuba 3 scene XML, read into a [`SceneDesc`]. `xml` reads the file into a tree
+//! (includes, defaults, `$name` substitution, 0.x upgrades), `props` reads typed parameters,
+//! and this module maps each plugin onto the description. What glint supports, plugin by
+//! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
+//! an error that names the plugin, the file and the line.
 
 mod props;
 pub mod xml;
 
-use super::builder::{Emission, SceneBuilder};
-use super::{LightSelection, LoadOptions, LoadedScene};
-use crate::bsdf::{Microfacet, MicrofacetKind};
-use crate::camera::{Camera, FovAxis};
-use crate::integrators::{Integrator, PathSettings};
-use crate::lights::Light;
-use crate::materials::{conductor_preset, Bitmap, Material, MaterialKind, Texture};
-use crate::math::{Frame, Rgb, Vec3};
-use crate::render::{PixelFilter, RenderSettings};
-use crate::sampling::SamplerKind;
+use super::Define;
+use crate::bsdf::MicrofacetKind;
+use crate::camera::FovAxis;
+use crate::describe::{
+    CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
+    MaterialRef, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, TextureDesc,
+};
+use crate::error::{Error, SourceLoc};
+use crate::materials::conductor_preset;
+use crate::math::{Rgb, Transform, Vec3};
+use crate::sampling::{PixelFilter, SamplerKind};
 use props::{color_of, Props};
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::Arc;
 use xml::Element;
 
 /// Refractive indices Mitsuba accepts by name.
@@ -53,38 +53,44 @@ fn named_ior(name: &str) -> Option<f32> {
     })
 }
 
-struct Loader<'a> {
-    b: SceneBuilder,
-    opts: &'a LoadOptions,
+struct Reader<'a> {
     /// Named top-level objects (`id`), for `<ref>`.
     named: HashMap<String, &'a Element>,
-    materials: HashMap<*const Element, u32>,
+    /// Materials already described, by the element that defines them.
+    material_index: HashMap<*const Element, usize>,
+    materials: Vec<MaterialDesc>,
+    shapes: Vec<ShapeDesc>,
+    lights: Vec<LightDesc>,
     warnings: Vec<String>,
 }
 
-pub fn load(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, String> {
-    let root = xml::load_tree(path, &opts.defines)?;
-    let mut l = Loader {
-        b: SceneBuilder::new(opts.bvh_split),
-        opts,
+pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
+    let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
+    let root = xml::load_tree(path, &defines)?;
+    let mut r = Reader {
         named: HashMap::new(),
-        materials: HashMap::new(),
+        material_index: HashMap::new(),
+        materials: Vec::new(),
+        shapes: Vec::new(),
+        lights: Vec::new(),
         warnings: Vec::new(),
     };
     for c in &root.children {
         if let Some(id) = c.attr("id") {
-            l.named.insert(id.to_string(), c);
+            if r.named.insert(id.to_string(), c).is_some() {
+                return Err(c.err(format!("two objects have the id '{id}'")));
+            }
         }
     }
     let mut sensor = None;
     let mut integrator_el = None;
     for c in &root.children {
         match c.tag.as_str() {
-            "shape" => l.shape(c)?,
-            "emitter" => l.emitter(c)?,
+            "shape" => r.shape(c)?,
+            "emitter" => r.emitter(c)?,
             "sensor" => sensor = Some(c),
             "integrator" => integrator_el = Some(c),
-            // Named BSDFs and textures are built when a shape refers to them.
+            // Named BSDFs and textures are described when a shape refers to them.
             "bsdf" | "texture" => {}
             "medium" | "phase" | "volume" => {
                 return Err(c.err(format!("<{}> (participating media) is not supported", c.tag)))
@@ -92,33 +98,41 @@ pub fn load(path: &Path, opts: &LoadOptions) -> Result<LoadedScene, String> {
             other => return Err(c.err(format!("unexpected element <{other}> in <scene>"))),
         }
     }
-    let sensor = sensor.ok_or_else(|| format!("{}: the scene has no <sensor>", path.display()))?;
-    let (camera, mut settings) = l.sensor(sensor)?;
+    let sensor = sensor.ok_or_else(|| Error::at(&SourceLoc::file(path), "the scene has no <sensor>"))?;
+    let (camera, film, seed) = r.sensor(sensor)?;
     let integrator = match integrator_el {
-        Some(e) => l.integrator(e)?,
-        None => Integrator::Path(PathSettings::default()),
+        Some(e) => r.integrator(e)?,
+        None => IntegratorDesc::Path(PathSettings::default()),
     };
-    if let Some(spp) = settings_spp(sensor)? {
-        settings.spp = spp;
-    }
-    let mut scene = l.b.finish(camera, LightSelection::Power).map_err(|e| format!("{}: {e}", path.display()))?;
-    scene.set_light_selection(LightSelection::Power);
-    Ok(LoadedScene { scene, integrator, settings, warnings: l.warnings })
+    let mut desc = SceneDesc::empty(camera, film);
+    desc.source = Some(path.to_path_buf());
+    desc.integrator = integrator;
+    desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp: settings_spp(sensor)?.unwrap_or(16), seed };
+    desc.materials = r.materials;
+    desc.shapes = r.shapes;
+    desc.lights = r.lights;
+    desc.warnings = r.warnings;
+    Ok(desc)
 }
 
-fn settings_spp(sensor: &Element) -> Result<Option<u32>, String> {
-    for c in sensor.children.iter().filter(|c| c.tag == "sampler") {
+fn settings_spp(sensor: &Element) -> Result<Option<u32>, Error> {
+    if let Some(c) = sensor.children.iter().find(|c| c.tag == "sampler") {
         let p = Props::new(c);
         let n = p.int("sample_count", 4)?;
-        if n < 1 {
-            return Err(c.err("sample_count must be at least 1"));
+        let max = crate::describe::limits::MAX_SPP as i64;
+        if n < 1 || n > max {
+            return Err(c.err(format!("sample_count {n} is out of range (1 to {max})")));
         }
         return Ok(Some(n as u32));
     }
     Ok(None)
 }
 
-impl<'a> Loader<'a> {
+fn matrix(t: &Transform) -> crate::describe::Matrix4 {
+    t.m.0
+}
+
+impl<'a> Reader<'a> {
     fn warn_unused(&mut self, p: &Props) {
         for (name, line) in p.unused() {
             self.warnings.push(format!(
@@ -132,7 +146,7 @@ impl<'a> Loader<'a> {
     }
 
     /// Follows `<ref id>` to the named object.
-    fn resolve(&self, el: &'a Element) -> Result<&'a Element, String> {
+    fn resolve(&self, el: &'a Element) -> Result<&'a Element, Error> {
         if el.tag == "ref" {
             let id = el.required("id")?;
             return self
@@ -144,11 +158,11 @@ impl<'a> Loader<'a> {
         Ok(el)
     }
 
-    fn texture(&self, p: &Props<'a>, name: &str, default: Rgb) -> Result<Texture, String> {
-        let Some(e) = p.find(name) else { return Ok(Texture::Constant(default)) };
+    fn texture(&self, p: &Props<'a>, name: &str, default: Rgb) -> Result<TextureDesc, Error> {
+        let Some(e) = p.find(name) else { return Ok(TextureDesc::constant(default)) };
         let e = self.resolve(e)?;
         if e.tag != "texture" {
-            return Ok(Texture::Constant(color_of(e)?));
+            return Ok(TextureDesc::constant(color_of(e)?));
         }
         let tp = Props::new(e);
         let to_uv = tp.transform("to_uv")?;
@@ -156,28 +170,27 @@ impl<'a> Loader<'a> {
         let o = to_uv.point(Vec3::ZERO);
         let sx = to_uv.vector(Vec3::X).x;
         let sy = to_uv.vector(Vec3::Y).y;
-        let (scale, offset) = ([sx, sy], [o.x, o.y]);
+        let (uv_scale, uv_offset) = ([sx, sy], [o.x, o.y]);
         match e.attr("type").unwrap_or("") {
             "bitmap" => {
                 let file = tp.string("filename").ok_or_else(|| e.err("bitmap texture needs 'filename'"))?;
                 let path = e.file.parent().unwrap_or(Path::new(".")).join(file);
                 let raw = tp.bool("raw", false)?;
-                let bm = Bitmap::load(&path, raw).map_err(|err| e.err(err))?;
                 let _ = tp.string("filter_type");
                 let _ = tp.string("wrap_mode");
-                Ok(Texture::Bitmap { image: Arc::new(bm), uv_scale: scale, uv_offset: offset })
+                Ok(TextureDesc::Bitmap { file: path, raw, uv_scale, uv_offset, loc: e.loc() })
             }
-            "checkerboard" => Ok(Texture::Checkerboard {
+            "checkerboard" => Ok(TextureDesc::Checkerboard {
                 color0: tp.rgb("color0", Rgb::splat(0.4))?,
                 color1: tp.rgb("color1", Rgb::splat(0.2))?,
-                uv_scale: scale,
-                uv_offset: offset,
+                uv_scale,
+                uv_offset,
             }),
             other => Err(e.err(format!("texture plugin '{other}' is not supported (bitmap, checkerboard)"))),
         }
     }
 
-    fn ior(&self, p: &Props, name: &str, default: f32) -> Result<f32, String> {
+    fn ior(&self, p: &Props, name: &str, default: f32) -> Result<f32, Error> {
         match p.find(name) {
             None => Ok(default),
             Some(e) if e.tag == "string" => {
@@ -188,8 +201,8 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn microfacet(&self, p: &Props) -> Result<Microfacet, String> {
-        let kind = match p.string("distribution").unwrap_or("beckmann") {
+    fn roughness(&self, p: &Props) -> Result<Roughness, Error> {
+        let distribution = match p.string("distribution").unwrap_or("beckmann") {
             "beckmann" => MicrofacetKind::Beckmann,
             "ggx" => MicrofacetKind::Ggx,
             other => return Err(p.el.err(format!("unknown microfacet distribution '{other}'"))),
@@ -202,10 +215,10 @@ impl<'a> Loader<'a> {
             _ => p.float("alpha", 0.1)?,
         };
         let _ = p.bool("sample_visible", true)?;
-        Ok(Microfacet::new(kind, alpha))
+        Ok(Roughness { distribution, alpha })
     }
 
-    fn conductor_ior(&self, p: &Props) -> Result<(Rgb, Rgb), String> {
+    fn conductor_ior(&self, p: &Props) -> Result<(Rgb, Rgb), Error> {
         let (eta_el, k_el) = (p.find("eta"), p.find("k"));
         if eta_el.is_some() || k_el.is_some() {
             return Ok((p.rgb("eta", Rgb::BLACK)?, p.rgb("k", Rgb::WHITE)?));
@@ -215,26 +228,27 @@ impl<'a> Loader<'a> {
             .ok_or_else(|| p.el.err(format!("conductor material '{name}' is not known (Au, Ag, Cu, Al, Cr, none)")))
     }
 
-    /// Builds (once) the material of a `<bsdf>` element.
-    fn material(&mut self, el: &'a Element) -> Result<u32, String> {
+    /// Describes (once) the material of a `<bsdf>` element; its index in the materials.
+    fn material(&mut self, el: &'a Element) -> Result<usize, Error> {
         let el = self.resolve(el)?;
-        if let Some(&id) = self.materials.get(&(el as *const Element)) {
-            return Ok(id);
+        if let Some(&i) = self.material_index.get(&(el as *const Element)) {
+            return Ok(i);
         }
         if el.tag != "bsdf" {
             return Err(el.err(format!("expected a <bsdf>, found <{}>", el.tag)));
         }
-        let (kind, two_sided) = self.material_kind(el)?;
+        let (model, two_sided) = self.material_model(el)?;
         let name = el.attr("id").map_or_else(|| format!("bsdf@{}:{}", el.file.display(), el.line), str::to_string);
-        let id = self.b.add_material(Material::new(name, kind, two_sided));
-        self.materials.insert(el as *const Element, id);
-        Ok(id)
+        let i = self.materials.len();
+        self.materials.push(MaterialDesc { name, model, two_sided, loc: el.loc() });
+        self.material_index.insert(el as *const Element, i);
+        Ok(i)
     }
 
-    fn material_kind(&mut self, el: &'a Element) -> Result<(MaterialKind, bool), String> {
+    fn material_model(&mut self, el: &'a Element) -> Result<(MaterialModel, bool), Error> {
         let ty = el.attr("type").unwrap_or("");
         let p = Props::new(el);
-        let kind = match ty {
+        let model = match ty {
             "twosided" => {
                 let inner: Vec<&Element> = el.children.iter().filter(|c| c.tag == "bsdf" || c.tag == "ref").collect();
                 if inner.len() != 1 {
@@ -243,31 +257,21 @@ impl<'a> Loader<'a> {
                     );
                 }
                 let inner = self.resolve(inner[0])?;
-                let (k, _) = self.material_kind(inner)?;
-                return Ok((k, true));
+                let (m, _) = self.material_model(inner)?;
+                return Ok((m, true));
             }
-            "diffuse" => MaterialKind::Diffuse { reflectance: self.texture(&p, "reflectance", Rgb::splat(0.5))? },
-            "conductor" => {
+            "diffuse" => MaterialModel::Diffuse { reflectance: self.texture(&p, "reflectance", Rgb::splat(0.5))? },
+            "conductor" | "roughconductor" => {
+                let roughness = if ty == "roughconductor" { Some(self.roughness(&p)?) } else { None };
                 let (eta, k) = self.conductor_ior(&p)?;
-                MaterialKind::Conductor { eta, k, specular: p.rgb("specular_reflectance", Rgb::WHITE)? }
-            }
-            "roughconductor" => {
-                let dist = self.microfacet(&p)?;
-                let (eta, k) = self.conductor_ior(&p)?;
-                MaterialKind::RoughConductor { dist, eta, k, specular: p.rgb("specular_reflectance", Rgb::WHITE)? }
+                MaterialModel::Conductor { eta, k, specular: p.rgb("specular_reflectance", Rgb::WHITE)?, roughness }
             }
             "dielectric" | "roughdielectric" | "thindielectric" => {
                 let eta = self.ior(&p, "int_ior", 1.5046)? / self.ior(&p, "ext_ior", 1.000277)?;
                 let reflect = p.rgb("specular_reflectance", Rgb::WHITE)?;
                 let transmit = p.rgb("specular_transmittance", Rgb::WHITE)?;
-                match ty {
-                    "dielectric" => MaterialKind::Dielectric { eta, reflect, transmit },
-                    "thindielectric" => MaterialKind::ThinDielectric { eta, reflect, transmit },
-                    _ => {
-                        let dist = self.microfacet(&p)?;
-                        MaterialKind::RoughDielectric { dist, eta, reflect, transmit }
-                    }
-                }
+                let roughness = if ty == "roughdielectric" { Some(self.roughness(&p)?) } else { None };
+                MaterialModel::Dielectric { eta, reflect, transmit, roughness, thin: ty == "thindielectric" }
             }
             "plastic" | "roughplastic" => {
                 let eta = self.ior(&p, "int_ior", 1.49)? / self.ior(&p, "ext_ior", 1.000277)?;
@@ -276,20 +280,20 @@ impl<'a> Loader<'a> {
                 if p.bool("nonlinear", false)? {
                     return Err(el.err(format!("{ty}: nonlinear=true is not supported")));
                 }
-                let dist = if ty == "roughplastic" { Some(self.microfacet(&p)?) } else { None };
-                Material::plastic(diffuse, specular, eta, dist)
+                let roughness = if ty == "roughplastic" { Some(self.roughness(&p)?) } else { None };
+                MaterialModel::Plastic { diffuse, specular, eta, roughness }
             }
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
-        Ok((kind, false))
+        Ok((model, false))
     }
 
-    fn shape(&mut self, el: &'a Element) -> Result<(), String> {
+    fn shape(&mut self, el: &'a Element) -> Result<(), Error> {
         let p = Props::new(el);
         let ty = el.attr("type").unwrap_or("");
         let to_world = p.transform("to_world")?;
-        let flip = p.bool("flip_normals", false)?;
+        let flip_normals = p.bool("flip_normals", false)?;
         // BSDF: a nested <bsdf> or a <ref> to one.
         let mut material = None;
         let mut emission = None;
@@ -314,103 +318,88 @@ impl<'a> Loader<'a> {
                     emission = Some(Emission { radiance: ep.rgb("radiance", Rgb::WHITE)?, two_sided: false });
                     self.warn_unused(&ep);
                 }
+                "medium" => return Err(c.err("<medium> (participating media) is not supported")),
                 _ => {}
             }
         }
-        let material = match material {
-            Some(m) => m,
-            None => self.b.default_material(),
-        };
-        let here = |e: String| el.err(format!("shape '{ty}': {e}"));
-        match ty {
+        let material = material.map_or(MaterialRef::DefaultDiffuse, MaterialRef::Index);
+        let geometry = match ty {
             "obj" | "ply" => {
                 let file = p.string("filename").ok_or_else(|| el.err(format!("shape '{ty}' needs 'filename'")))?;
                 let path = el.file.parent().unwrap_or(Path::new(".")).join(file);
-                if !path.exists() {
-                    return Err(el.err(format!("mesh file '{}' does not exist", path.display())));
-                }
-                let face_normals = p.bool("face_normals", false)?;
-                let groups = self.b.load_mesh_file(&path, face_normals).map_err(|e| el.err(e))?;
-                for g in &groups {
-                    self.b.add_mesh_instance(&g.mesh, &to_world, false, material, emission, flip).map_err(here)?;
-                }
+                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)? }
             }
             "sphere" => {
-                let c = p.point("center")?.unwrap_or(Vec3::ZERO);
-                let r = p.float("radius", 1.0)?;
-                self.b.add_sphere(c, r, &to_world, material, emission, flip).map_err(here)?;
+                Geometry::Sphere { center: p.point("center")?.unwrap_or(Vec3::ZERO), radius: p.float("radius", 1.0)? }
             }
-            "rectangle" | "cube" | "disk" => {
-                let split = self.opts.bvh_split;
-                let mesh = match ty {
-                    "rectangle" => crate::geometry::quad_mesh(
-                        [
-                            Vec3 { x: -1.0, y: -1.0, z: 0.0 },
-                            Vec3 { x: 1.0, y: -1.0, z: 0.0 },
-                            Vec3 { x: 1.0, y: 1.0, z: 0.0 },
-                            Vec3 { x: -1.0, y: 1.0, z: 0.0 },
-                        ],
-                        split,
-                    ),
-                    "cube" => crate::geometry::cube_mesh(split),
-                    _ => crate::geometry::disk_mesh(256, split),
-                };
-                self.b.add_mesh_instance(&Arc::new(mesh), &to_world, false, material, emission, flip).map_err(here)?;
-            }
+            "rectangle" => Geometry::Rectangle,
+            "cube" => Geometry::Cube,
+            "disk" => Geometry::Disk,
             other => return Err(el.err(format!("shape plugin '{other}' is not supported"))),
-        }
+        };
         self.warn_unused(&p);
+        self.shapes.push(ShapeDesc {
+            geometry,
+            to_world: matrix(&to_world),
+            material,
+            use_mtl: false,
+            emission,
+            flip_normals,
+            loc: el.loc(),
+        });
         Ok(())
     }
 
-    fn emitter(&mut self, el: &'a Element) -> Result<(), String> {
+    fn emitter(&mut self, el: &'a Element) -> Result<(), Error> {
         let p = Props::new(el);
         let to_world = p.transform("to_world")?;
-        match el.attr("type").unwrap_or("") {
-            "point" => {
-                let pos = match p.point("position")? {
+        let light = match el.attr("type").unwrap_or("") {
+            "point" => LightKind::Point {
+                position: match p.point("position")? {
                     Some(v) => v,
                     None => to_world.point(Vec3::ZERO),
-                };
-                self.b.add_light(Light::Point { position: pos, intensity: p.rgb("intensity", Rgb::WHITE)? });
-            }
+                },
+                intensity: p.rgb("intensity", Rgb::WHITE)?,
+            },
             "spot" => {
-                let cutoff = p.float("cutoff_angle", 20.0)?;
-                let beam = p.float("beam_width", cutoff * 0.75)?;
-                let dir = to_world.vector(Vec3::Z).normalize();
-                self.b.add_light(Light::Spot {
-                    position: to_world.point(Vec3::ZERO),
-                    frame: Frame::from_normal(dir),
-                    intensity: p.rgb("intensity", Rgb::WHITE)?,
-                    cutoff: cutoff.to_radians(),
-                    beam: beam.min(cutoff).to_radians(),
-                });
                 if p.find("texture").is_some() {
                     return Err(el.err("spot: projected textures are not supported"));
                 }
+                let cutoff = p.float("cutoff_angle", 20.0)?;
+                LightKind::Spot {
+                    position: to_world.point(Vec3::ZERO),
+                    direction: to_world.vector(Vec3::Z),
+                    intensity: p.rgb("intensity", Rgb::WHITE)?,
+                    cutoff_degrees: cutoff,
+                    beam_degrees: p.float("beam_width", cutoff * 0.75)?,
+                }
             }
-            "directional" => {
-                let d = match p.point("direction")? {
+            "directional" => LightKind::Directional {
+                direction: match p.point("direction")? {
                     Some(v) => v,
                     None => to_world.vector(Vec3::Z),
-                };
-                self.b.add_directional(d, p.rgb("irradiance", Rgb::WHITE)?);
-            }
-            "constant" => self.b.add_constant_environment(p.rgb("radiance", Rgb::WHITE)?),
+                },
+                irradiance: p.rgb("irradiance", Rgb::WHITE)?,
+            },
+            "constant" => LightKind::Constant { radiance: p.rgb("radiance", Rgb::WHITE)? },
             "envmap" => {
                 let file = p.string("filename").ok_or_else(|| el.err("envmap needs 'filename'"))?;
-                let path = el.file.parent().unwrap_or(Path::new(".")).join(file);
-                let img = Bitmap::load(&path, true).map_err(|e| el.err(e))?;
-                self.b.add_envmap(img, p.float("scale", 1.0)?, to_world);
+                LightKind::EnvMap {
+                    file: el.file.parent().unwrap_or(Path::new(".")).join(file),
+                    scale: p.float("scale", 1.0)?,
+                    to_world: matrix(&to_world),
+                }
             }
             "area" => return Err(el.err("an area emitter must be nested inside a <shape>")),
             other => return Err(el.err(format!("emitter plugin '{other}' is not supported"))),
-        }
+        };
         self.warn_unused(&p);
+        self.lights.push(LightDesc { light, loc: el.loc() });
         Ok(())
     }
 
-    fn sensor(&mut self, el: &'a Element) -> Result<(Camera, RenderSettings), String> {
+    /// The camera, the film and the sampler's seed.
+    fn sensor(&mut self, el: &'a Element) -> Result<(CameraDesc, FilmDesc, u64), Error> {
         let ty = el.attr("type").unwrap_or("");
         if ty != "perspective" && ty != "thinlens" {
             return Err(el.err(format!("sensor plugin '{ty}' is not supported (perspective, thinlens)")));
@@ -427,27 +416,37 @@ impl<'a> Loader<'a> {
             }
             (None, None) => 2.0 * (43.266_615f32 / (2.0 * 50.0)).atan().to_degrees(),
         };
-        let axis: FovAxis = match p.string("fov_axis") {
-            Some(a) => a.parse().map_err(|e| el.err(e))?,
+        let fov_axis: FovAxis = match p.string("fov_axis") {
+            Some(a) => a.parse().map_err(|e: String| el.err(e))?,
             None if p.opt_float("fov")?.is_some() => FovAxis::X,
             None => FovAxis::Diagonal,
         };
-        let film = el.children.iter().find(|c| c.tag == "film");
-        let (mut w, mut h, mut filter) = (768u32, 576u32, PixelFilter::Gaussian { stddev: 0.5 });
-        if let Some(f) = film {
+        let film_el = el.children.iter().find(|c| c.tag == "film");
+        let mut film =
+            FilmDesc { width: 768, height: 576, filter: PixelFilter::Gaussian { stddev: 0.5 }, loc: el.loc() };
+        if let Some(f) = film_el {
             if f.attr("type") != Some("hdrfilm") {
                 return Err(f.err(format!("film plugin '{}' is not supported (hdrfilm)", f.attr("type").unwrap_or(""))));
             }
             let fp = Props::new(f);
-            w = fp.int("width", 768)?.clamp(0, u32::MAX as i64) as u32;
-            h = fp.int("height", 576)?.clamp(0, u32::MAX as i64) as u32;
+            let side = |name: &str, default: i64| -> Result<u32, Error> {
+                let v = fp.int(name, default)?;
+                let max = crate::describe::limits::MAX_SIDE as i64;
+                if v < 1 || v > max {
+                    return Err(f.err(format!("film {name} {v} is out of range (1 to {max})")));
+                }
+                Ok(v as u32)
+            };
+            film.width = side("width", 768)?;
+            film.height = side("height", 576)?;
+            film.loc = f.loc();
             let _ = fp.string("pixel_format");
             let _ = fp.string("component_format");
             let _ = fp.string("file_format");
             let _ = fp.bool("banner", false);
             if let Some(rf) = f.children.iter().find(|c| c.tag == "rfilter") {
                 let rp = Props::new(rf);
-                filter = match rf.attr("type").unwrap_or("") {
+                film.filter = match rf.attr("type").unwrap_or("") {
                     "box" => PixelFilter::Box,
                     "tent" => PixelFilter::Tent { radius: rp.float("radius", 1.0)? },
                     "gaussian" => PixelFilter::Gaussian { stddev: rp.float("stddev", 0.5)? },
@@ -459,40 +458,61 @@ impl<'a> Loader<'a> {
             }
             self.warn_unused(&fp);
         }
-        let (w, h) = (self.opts.width.unwrap_or(w), self.opts.height.unwrap_or(h));
-        super::json::check_resolution(w, h).map_err(|e| el.err(e))?;
-        let mut camera = Camera::new(to_world, w, h, fov, axis);
-        camera.near_clip = p.float("near_clip", 1e-2)?;
-        camera.far_clip = p.float("far_clip", 1e4)?;
+        let mut camera = CameraDesc {
+            to_world: Some(matrix(&to_world)),
+            fov_degrees: fov,
+            fov_axis,
+            lens_radius: 0.0,
+            focus_distance: 1.0,
+            near_clip: p.float("near_clip", 1e-2)?,
+            far_clip: p.float("far_clip", 1e4)?,
+            loc: el.loc(),
+        };
         // Perspective cameras accept (and, like Mitsuba, ignore) a focus distance.
         let _ = p.opt_float("focus_distance")?;
         if ty == "thinlens" {
             camera.lens_radius = p.float("aperture_radius", 0.0)?;
             camera.focus_distance = p.float("focus_distance", 0.0)?;
-            if camera.focus_distance <= 0.0 {
+            if !(camera.focus_distance > 0.0) {
                 return Err(el.err("thinlens needs a positive focus_distance"));
             }
         }
-        let mut settings = RenderSettings { filter, sampler: SamplerKind::Sobol, ..Default::default() };
+        let mut seed = 0;
         if let Some(s) = el.children.iter().find(|c| c.tag == "sampler") {
             let sp = Props::new(s);
-            settings.seed = sp.int("seed", 0)?.max(0) as u64;
+            let v = sp.int("seed", 0)?;
+            if v < 0 {
+                return Err(s.err(format!("seed {v} must not be negative")));
+            }
+            seed = v as u64;
         }
         self.warn_unused(&p);
-        Ok((camera, settings))
+        Ok((camera, film, seed))
     }
 
-    fn integrator(&mut self, el: &'a Element) -> Result<Integrator, String> {
+    fn integrator(&mut self, el: &'a Element) -> Result<IntegratorDesc, Error> {
         let p = Props::new(el);
         let ty = el.attr("type").unwrap_or("");
-        let depth = |p: &Props, default: i64| -> Result<Option<u32>, String> {
+        let depth = |p: &Props, default: i64| -> Result<Option<u32>, Error> {
             let d = p.int("max_depth", default)?;
+            if d >= u32::MAX as i64 {
+                return Err(
+                    el.err(format!("max_depth {d} is out of range (-1 for unbounded, or 0 to {})", u32::MAX - 1))
+                );
+            }
             Ok(if d < 0 { None } else { Some(d as u32) })
+        };
+        let rr_depth = |p: &Props| -> Result<u32, Error> {
+            let d = p.int("rr_depth", 5)?;
+            if !(1..u32::MAX as i64).contains(&d) {
+                return Err(el.err(format!("rr_depth {d} is out of range (1 to {})", u32::MAX - 1)));
+            }
+            Ok(d as u32)
         };
         let settings = match ty {
             "path" => PathSettings {
                 max_depth: depth(&p, -1)?,
-                rr_depth: p.int("rr_depth", 5)?.max(1) as u32,
+                rr_depth: rr_depth(&p)?,
                 hide_emitters: p.bool("hide_emitters", false)?,
                 ..Default::default()
             },
@@ -506,10 +526,11 @@ impl<'a> Loader<'a> {
                 }
             }
             other => {
-                self.warnings.push(el.err(format!("integrator '{other}' is not supported; using 'path' instead")));
+                self.warnings
+                    .push(el.err(format!("integrator '{other}' is not supported; using 'path' instead")).to_string());
                 PathSettings {
                     max_depth: depth(&p, -1)?,
-                    rr_depth: p.int("rr_depth", 5)?.max(1) as u32,
+                    rr_depth: rr_depth(&p)?,
                     hide_emitters: p.bool("hide_emitters", false)?,
                     ..Default::default()
                 }
@@ -518,6 +539,6 @@ impl<'a> Loader<'a> {
         if ty == "path" || ty == "direct" {
             self.warn_unused(&p);
         }
-        Ok(Integrator::Path(settings))
+        Ok(IntegratorDesc::Path(settings))
     }
 }

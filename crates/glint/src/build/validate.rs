@@ -1,0 +1,245 @@
+//! Checks a description before anything is built: every number that enters the world is
+//! finite and in its range, so that no NaN or infinity reaches the BVH or the integrators.
+//! Each error names the entity's source location and the allowed range.
+
+use crate::describe::{
+    CameraDesc, FilmDesc, Geometry, IntegratorDesc, LightKind, MaterialModel, Matrix4, SceneDesc, TextureDesc,
+};
+use crate::error::{Error, SourceLoc};
+use crate::math::{Rgb, Vec3};
+use crate::sampling::PixelFilter;
+
+use crate::describe::limits::{check_resolution, MAX_SPP, MAX_WHITTED_DEPTH};
+
+pub fn check(d: &SceneDesc) -> Result<(), Error> {
+    film(&d.film)?;
+    camera(&d.camera)?;
+    let origin = d.source.as_deref().map(SourceLoc::file).unwrap_or_default();
+    if d.sampler.spp == 0 || d.sampler.spp > MAX_SPP {
+        return Err(Error::at(
+            &origin,
+            format!("samples per pixel {} is out of range (1 to {MAX_SPP})", d.sampler.spp),
+        ));
+    }
+    match &d.integrator {
+        IntegratorDesc::Whitted(w) => {
+            if w.max_depth == 0 || w.max_depth > MAX_WHITTED_DEPTH {
+                return Err(Error::at(
+                    &origin,
+                    format!("whitted: max_depth {} is out of range (1 to {MAX_WHITTED_DEPTH})", w.max_depth),
+                ));
+            }
+            color(Rgb::from_array(w.background), "whitted: background").map_err(|m| Error::at(&origin, m))?;
+        }
+        IntegratorDesc::Path(p) => {
+            if let Some(q) = p.rr_probability {
+                if !(q > 0.0 && q <= 1.0) {
+                    return Err(Error::at(&origin, format!("path: rr_probability {q} is out of range (0, 1]")));
+                }
+            }
+        }
+    }
+    let mut names = std::collections::HashSet::new();
+    for m in &d.materials {
+        if !names.insert(m.name.as_str()) {
+            return Err(Error::at(&m.loc, format!("material '{}' is defined twice", m.name)));
+        }
+        material(&m.model).map_err(|e| Error::at(&m.loc, format!("material '{}': {e}", m.name)))?;
+    }
+    for s in &d.shapes {
+        matrix(&s.to_world, "to_world").map_err(|m| Error::at(&s.loc, m))?;
+        if let Some(e) = &s.emission {
+            color(e.radiance, "emitted radiance").map_err(|m| Error::at(&s.loc, m))?;
+        }
+        match &s.geometry {
+            Geometry::Sphere { center, radius } => {
+                vector(*center, "sphere centre").map_err(|m| Error::at(&s.loc, m))?;
+                if !(*radius > 0.0 && radius.is_finite()) {
+                    return Err(Error::at(&s.loc, format!("sphere radius {radius} must be positive and finite")));
+                }
+            }
+            Geometry::Mesh(m) => {
+                if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
+                    return Err(Error::at(&s.loc, format!("mesh vertex {i} is not finite")));
+                }
+            }
+            _ => {}
+        }
+    }
+    for l in &d.lights {
+        light(&l.light).map_err(|m| Error::at(&l.loc, m))?;
+    }
+    Ok(())
+}
+
+fn film(f: &FilmDesc) -> Result<(), Error> {
+    check_resolution(f.width, f.height).map_err(|e| Error::at(&f.loc, e))?;
+    let ok = match f.filter {
+        PixelFilter::Box => true,
+        PixelFilter::Tent { radius } => radius > 0.0 && radius.is_finite() && radius <= 64.0,
+        PixelFilter::Gaussian { stddev } => stddev > 0.0 && stddev.is_finite() && stddev <= 16.0,
+    };
+    if !ok {
+        return Err(Error::at(
+            &f.loc,
+            format!(
+                "{:?}: the filter width is out of range (tent radius in (0, 64], gaussian stddev in (0, 16])",
+                f.filter
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn camera(c: &CameraDesc) -> Result<(), Error> {
+    let here = |m: String| Error::at(&c.loc, format!("camera: {m}"));
+    if let Some(m) = &c.to_world {
+        matrix(m, "to_world").map_err(here)?;
+    }
+    if !(c.fov_degrees > 0.0 && c.fov_degrees < 180.0) {
+        return Err(here(format!("field of view {} is out of range (0, 180) degrees", c.fov_degrees)));
+    }
+    if !(c.lens_radius >= 0.0 && c.lens_radius.is_finite()) {
+        return Err(here(format!("aperture radius {} must be finite and at least 0", c.lens_radius)));
+    }
+    if c.lens_radius > 0.0 && !(c.focus_distance > 0.0 && c.focus_distance.is_finite()) {
+        return Err(here(format!("focus distance {} must be positive and finite", c.focus_distance)));
+    }
+    if !(c.near_clip >= 0.0 && c.near_clip.is_finite() && c.far_clip > c.near_clip) {
+        return Err(here(format!(
+            "near_clip {} and far_clip {}: need 0 <= near_clip < far_clip, near_clip finite",
+            c.near_clip, c.far_clip
+        )));
+    }
+    Ok(())
+}
+
+fn material(m: &MaterialModel) -> Result<(), String> {
+    for t in m.textures() {
+        match t {
+            TextureDesc::Constant { color: c } => color(*c, "colour")?,
+            TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {
+                color(*color0, "color0")?;
+                color(*color1, "color1")?;
+                uv(uv_scale, uv_offset)?;
+            }
+            TextureDesc::Bitmap { uv_scale, uv_offset, .. } => uv(uv_scale, uv_offset)?,
+        }
+    }
+    let alpha = |r: &Option<crate::describe::Roughness>| -> Result<(), String> {
+        match r {
+            Some(r) if !(r.alpha > 0.0 && r.alpha.is_finite()) => {
+                Err(format!("roughness alpha {} must be positive and finite", r.alpha))
+            }
+            _ => Ok(()),
+        }
+    };
+    let eta_ok = |eta: f32| -> Result<(), String> {
+        if eta > 0.0 && eta.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("index of refraction {eta} must be positive and finite"))
+        }
+    };
+    match m {
+        MaterialModel::Phong { ks, exponent, .. } => {
+            color(*ks, "ks")?;
+            if !(*exponent >= 0.0 && exponent.is_finite()) {
+                return Err(format!("Phong exponent {exponent} must be finite and at least 0"));
+            }
+        }
+        MaterialModel::Conductor { eta, k, specular, roughness } => {
+            color(*eta, "eta")?;
+            color(*k, "k")?;
+            color(*specular, "specular reflectance")?;
+            alpha(roughness)?;
+        }
+        MaterialModel::Dielectric { eta, reflect, transmit, roughness, .. } => {
+            eta_ok(*eta)?;
+            color(*reflect, "specular reflectance")?;
+            color(*transmit, "specular transmittance")?;
+            alpha(roughness)?;
+        }
+        MaterialModel::Plastic { specular, eta, roughness, .. } => {
+            eta_ok(*eta)?;
+            color(*specular, "specular reflectance")?;
+            alpha(roughness)?;
+        }
+        MaterialModel::Diffuse { .. } | MaterialModel::Black => {}
+    }
+    Ok(())
+}
+
+fn light(l: &LightKind) -> Result<(), String> {
+    match l {
+        LightKind::Point { position, intensity } => {
+            vector(*position, "position")?;
+            color(*intensity, "intensity")
+        }
+        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees } => {
+            vector(*position, "position")?;
+            direction_of(*direction, "spot direction (its target equals its position?)")?;
+            color(*intensity, "intensity")?;
+            if !(*cutoff_degrees > 0.0 && *cutoff_degrees <= 180.0) {
+                return Err(format!("spot cutoff angle {cutoff_degrees} is out of range (0, 180] degrees"));
+            }
+            if !(*beam_degrees >= 0.0 && beam_degrees.is_finite()) {
+                return Err(format!("spot beam width {beam_degrees} must be finite and at least 0"));
+            }
+            Ok(())
+        }
+        LightKind::Directional { direction, irradiance } => {
+            direction_of(*direction, "direction")?;
+            color(*irradiance, "irradiance")
+        }
+        LightKind::Constant { radiance } => color(*radiance, "radiance"),
+        LightKind::EnvMap { scale, to_world, .. } => {
+            if !(*scale >= 0.0 && scale.is_finite()) {
+                return Err(format!("envmap scale {scale} must be finite and at least 0"));
+            }
+            matrix(to_world, "to_world")
+        }
+    }
+}
+
+fn color(c: Rgb, what: &str) -> Result<(), String> {
+    if c.to_array().iter().all(|v| v.is_finite() && *v >= 0.0) {
+        Ok(())
+    } else {
+        Err(format!("{what} ({}, {}, {}) must be finite and not negative", c.r, c.g, c.b))
+    }
+}
+
+fn vector(v: Vec3, what: &str) -> Result<(), String> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{what} ({}, {}, {}) is not finite", v.x, v.y, v.z))
+    }
+}
+
+fn direction_of(v: Vec3, what: &str) -> Result<(), String> {
+    vector(v, what)?;
+    if v.length_squared() > 0.0 && v.normalize().is_finite() {
+        Ok(())
+    } else {
+        Err(format!("{what} is zero"))
+    }
+}
+
+fn matrix(m: &Matrix4, what: &str) -> Result<(), String> {
+    // Checked as f32 too: the world is f32, and 1e39 is a finite f64 but infinite as f32.
+    if m.iter().flatten().all(|v| v.is_finite() && (*v as f32).is_finite()) {
+        Ok(())
+    } else {
+        Err(format!("{what}: the matrix has a NaN or infinite entry (or one beyond f32's range)"))
+    }
+}
+
+fn uv(scale: &[f32; 2], offset: &[f32; 2]) -> Result<(), String> {
+    if scale.iter().chain(offset).all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err("uv scale and offset must be finite".into())
+    }
+}

@@ -1,0 +1,639 @@
+//! glint's native JSON scene format (documented in docs/scene-format.md), read into a
+//! [`SceneDesc`]. The serde structures below mirror the file; `read` turns them into the
+//! description. Structural errors come from serde_json with their line and column; the
+//! others (an unknown material name, say) point at the offending value, found by its path
+//! in the document (`json_spans`), never by searching the text.
+
+use super::json_spans::Spans;
+use crate::bsdf::MicrofacetKind;
+use crate::camera::FovAxis;
+use crate::describe::{
+    CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
+    MaterialRef, Matrix4, MeshFileDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, Strategy,
+    TextureDesc, WhittedSettings,
+};
+use crate::error::{Error, SourceLoc};
+use crate::lights::LightSelection;
+use crate::materials::conductor_preset;
+use crate::math::{Mat4, Rgb, Transform, Vec3};
+use crate::sampling::{PixelFilter, SamplerKind};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonScene {
+    camera: JsonCamera,
+    film: JsonFilm,
+    #[serde(default)]
+    integrator: Option<JsonIntegrator>,
+    #[serde(default)]
+    sampler: JsonSampler,
+    #[serde(default)]
+    materials: BTreeMap<String, JsonMaterial>,
+    #[serde(default)]
+    meshes: BTreeMap<String, JsonMeshFile>,
+    #[serde(default)]
+    shapes: Vec<JsonShape>,
+    #[serde(default)]
+    lights: Vec<JsonLight>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonCamera {
+    position: [f32; 3],
+    look_at: [f32; 3],
+    #[serde(default = "default_up")]
+    up: [f32; 3],
+    fov: f32,
+    #[serde(default)]
+    fov_axis: Option<String>,
+    #[serde(default)]
+    aperture_radius: f32,
+    #[serde(default)]
+    focus_distance: Option<f32>,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonFilm {
+    width: u64,
+    height: u64,
+    #[serde(default)]
+    filter: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum JsonIntegrator {
+    Whitted {
+        #[serde(default)]
+        max_depth: Option<u64>,
+        #[serde(default)]
+        background: Option<[f32; 3]>,
+    },
+    Path {
+        #[serde(default)]
+        max_depth: Option<i64>,
+        #[serde(default)]
+        rr_depth: Option<u64>,
+        #[serde(default)]
+        rr_probability: Option<f32>,
+        #[serde(default)]
+        strategy: Option<Strategy>,
+        #[serde(default)]
+        light_selection: Option<String>,
+        #[serde(default)]
+        hide_emitters: bool,
+    },
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct JsonSampler {
+    #[serde(default, rename = "type")]
+    kind: Option<String>,
+    #[serde(default)]
+    spp: Option<u64>,
+    #[serde(default)]
+    seed: Option<u64>,
+}
+
+/// A colour: one number (grey) or three.
+#[derive(Deserialize, Clone, Copy)]
+#[serde(untagged)]
+enum JsonColor {
+    Grey(f32),
+    Rgb([f32; 3]),
+}
+
+impl JsonColor {
+    fn rgb(self) -> Rgb {
+        match self {
+            JsonColor::Grey(v) => Rgb::splat(v),
+            JsonColor::Rgb(a) => Rgb::from_array(a),
+        }
+    }
+}
+
+#[derive(Deserialize, Clone)]
+#[serde(untagged)]
+enum JsonTexture {
+    Color(JsonColor),
+    Bitmap {
+        texture: String,
+        #[serde(default)]
+        raw: bool,
+        #[serde(default)]
+        uv_scale: Option<[f32; 2]>,
+    },
+    Checker {
+        checkerboard: [JsonColor; 2],
+        #[serde(default)]
+        uv_scale: Option<[f32; 2]>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum JsonMaterial {
+    Diffuse {
+        reflectance: JsonTexture,
+        #[serde(default)]
+        two_sided: Option<bool>,
+    },
+    Phong {
+        kd: JsonTexture,
+        #[serde(default)]
+        ks: Option<JsonColor>,
+        #[serde(default)]
+        exponent: Option<f32>,
+        #[serde(default)]
+        two_sided: Option<bool>,
+    },
+    /// A perfect mirror: conductor with reflectance 1 (or `specular`).
+    Mirror {
+        #[serde(default)]
+        specular: Option<JsonColor>,
+    },
+    Conductor {
+        #[serde(default)]
+        metal: Option<String>,
+        #[serde(default)]
+        eta: Option<JsonColor>,
+        #[serde(default)]
+        k: Option<JsonColor>,
+        #[serde(default)]
+        specular: Option<JsonColor>,
+        #[serde(default)]
+        alpha: Option<f32>,
+        #[serde(default)]
+        distribution: Option<String>,
+    },
+    Dielectric {
+        #[serde(default)]
+        ior: Option<f32>,
+        #[serde(default)]
+        alpha: Option<f32>,
+        #[serde(default)]
+        distribution: Option<String>,
+        #[serde(default)]
+        thin: bool,
+    },
+    Plastic {
+        diffuse: JsonTexture,
+        #[serde(default)]
+        ior: Option<f32>,
+        #[serde(default)]
+        alpha: Option<f32>,
+        #[serde(default)]
+        distribution: Option<String>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonMeshFile {
+    file: String,
+    #[serde(default)]
+    face_normals: bool,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonShape {
+    #[serde(rename = "type")]
+    kind: String,
+    #[serde(default)]
+    file: Option<String>,
+    #[serde(default)]
+    mesh: Option<String>,
+    #[serde(default)]
+    center: Option<[f32; 3]>,
+    #[serde(default)]
+    radius: Option<f32>,
+    #[serde(default)]
+    material: Option<String>,
+    #[serde(default)]
+    transform: Vec<JsonTransformOp>,
+    #[serde(default)]
+    emission: Option<JsonColor>,
+    #[serde(default)]
+    two_sided_emission: bool,
+    #[serde(default)]
+    flip_normals: bool,
+    #[serde(default)]
+    face_normals: bool,
+}
+
+#[derive(Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+enum JsonTransformOp {
+    Translate([f32; 3]),
+    Scale(JsonColor),
+    Rotate { axis: [f32; 3], angle: f32 },
+    Matrix([f32; 16]),
+    LookAt { origin: [f32; 3], target: [f32; 3], up: [f32; 3] },
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum JsonLight {
+    Point {
+        position: [f32; 3],
+        intensity: JsonColor,
+    },
+    Spot {
+        position: [f32; 3],
+        target: [f32; 3],
+        intensity: JsonColor,
+        #[serde(default)]
+        cutoff_angle: Option<f32>,
+        #[serde(default)]
+        beam_width: Option<f32>,
+    },
+    Directional {
+        direction: [f32; 3],
+        irradiance: JsonColor,
+    },
+    Constant {
+        radiance: JsonColor,
+    },
+    Envmap {
+        file: String,
+        #[serde(default)]
+        scale: Option<f32>,
+        #[serde(default)]
+        transform: Vec<JsonTransformOp>,
+    },
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    spans: Spans,
+    dir: PathBuf,
+}
+
+impl Ctx<'_> {
+    /// The location of the value at a document path.
+    fn loc(&self, json_path: &str) -> SourceLoc {
+        let p = self.spans.get(json_path);
+        SourceLoc::new(self.path, p.line, p.col)
+    }
+    fn err(&self, json_path: &str, msg: impl Into<String>) -> Error {
+        Error::at(&self.loc(json_path), msg)
+    }
+    fn resolve(&self, p: &str) -> PathBuf {
+        self.dir.join(p)
+    }
+}
+
+/// A whole number from the file, checked against its range before it is narrowed.
+fn narrow(ctx: &Ctx, json_path: &str, what: &str, v: u64, min: u64, max: u64) -> Result<u32, Error> {
+    if v < min || v > max {
+        return Err(ctx.err(json_path, format!("{what} {v} is out of range ({min} to {max})")));
+    }
+    Ok(v as u32)
+}
+
+fn transform_of(ops: &[JsonTransformOp]) -> Result<Matrix4, String> {
+    let mut t = Transform::IDENTITY;
+    for op in ops {
+        let step = match op {
+            JsonTransformOp::Translate(v) => Transform::translate(Vec3::from_array(*v)),
+            JsonTransformOp::Scale(s) => {
+                let s = s.rgb();
+                Transform::scale(Vec3 { x: s.r, y: s.g, z: s.b }).ok_or("a scale of zero is not invertible")?
+            }
+            JsonTransformOp::Rotate { axis, angle } => {
+                if !(Vec3::from_array(*axis).length_squared() > 0.0) {
+                    return Err("rotate: the axis is zero".into());
+                }
+                Transform::rotate(Vec3::from_array(*axis), *angle)
+            }
+            JsonTransformOp::Matrix(m) => {
+                let mut a = [[0.0f64; 4]; 4];
+                for (i, v) in m.iter().enumerate() {
+                    a[i / 4][i % 4] = *v as f64;
+                }
+                Transform::from_matrix(Mat4(a)).ok_or("the matrix is not invertible")?
+            }
+            JsonTransformOp::LookAt { origin, target, up } => {
+                Transform::look_at(Vec3::from_array(*origin), Vec3::from_array(*target), Vec3::from_array(*up))
+                    .ok_or("look_at: degenerate direction or up vector")?
+            }
+        };
+        // Later operations apply after earlier ones.
+        t = step.then_after(&t);
+    }
+    Ok(t.m.0)
+}
+
+fn texture_of(ctx: &Ctx, json_path: &str, t: &JsonTexture) -> TextureDesc {
+    match t {
+        JsonTexture::Color(c) => TextureDesc::constant(c.rgb()),
+        JsonTexture::Bitmap { texture, raw, uv_scale } => TextureDesc::Bitmap {
+            file: ctx.resolve(texture),
+            raw: *raw,
+            uv_scale: uv_scale.unwrap_or([1.0, 1.0]),
+            uv_offset: [0.0, 0.0],
+            loc: ctx.loc(json_path),
+        },
+        JsonTexture::Checker { checkerboard, uv_scale } => TextureDesc::Checkerboard {
+            color0: checkerboard[0].rgb(),
+            color1: checkerboard[1].rgb(),
+            uv_scale: uv_scale.unwrap_or([1.0, 1.0]),
+            uv_offset: [0.0, 0.0],
+        },
+    }
+}
+
+fn roughness(ctx: &Ctx, at: &str, name: &Option<String>, alpha: Option<f32>) -> Result<Option<Roughness>, Error> {
+    let Some(alpha) = alpha.filter(|a| *a > 0.0 || a.is_nan()) else { return Ok(None) };
+    let distribution = match name.as_deref().unwrap_or("ggx") {
+        "ggx" => MicrofacetKind::Ggx,
+        "beckmann" => MicrofacetKind::Beckmann,
+        other => {
+            return Err(ctx.err(
+                &format!("{at}/distribution"),
+                format!("unknown microfacet distribution '{other}' (ggx or beckmann)"),
+            ))
+        }
+    };
+    Ok(Some(Roughness { distribution, alpha }))
+}
+
+fn material_of(ctx: &Ctx, name: &str, m: &JsonMaterial) -> Result<MaterialDesc, Error> {
+    let at = format!("materials/{name}");
+    let (model, two_sided) = match m {
+        JsonMaterial::Diffuse { reflectance, two_sided } => (
+            MaterialModel::Diffuse { reflectance: texture_of(ctx, &format!("{at}/reflectance"), reflectance) },
+            two_sided.unwrap_or(true),
+        ),
+        JsonMaterial::Phong { kd, ks, exponent, two_sided } => (
+            MaterialModel::Phong {
+                kd: texture_of(ctx, &format!("{at}/kd"), kd),
+                ks: ks.map_or(Rgb::BLACK, |c| c.rgb()),
+                exponent: exponent.unwrap_or(32.0),
+            },
+            two_sided.unwrap_or(true),
+        ),
+        JsonMaterial::Mirror { specular } => (
+            MaterialModel::Conductor {
+                eta: Rgb::BLACK,
+                k: Rgb::WHITE,
+                specular: specular.map_or(Rgb::WHITE, |c| c.rgb()),
+                roughness: None,
+            },
+            true,
+        ),
+        JsonMaterial::Conductor { metal, eta, k, specular, alpha, distribution } => {
+            let (e, kk) = match (metal, eta, k) {
+                (Some(mname), None, None) => conductor_preset(mname).ok_or_else(|| {
+                    ctx.err(&format!("{at}/metal"), format!("unknown metal '{mname}' (Au, Ag, Cu, Al, Cr)"))
+                })?,
+                (None, Some(e), Some(k)) => (e.rgb(), k.rgb()),
+                (None, None, None) => (Rgb::BLACK, Rgb::WHITE),
+                _ => return Err(ctx.err(&at, format!("material '{name}': give either 'metal' or both 'eta' and 'k'"))),
+            };
+            let specular = specular.map_or(Rgb::WHITE, |c| c.rgb());
+            let roughness = roughness(ctx, &at, distribution, *alpha)?;
+            (MaterialModel::Conductor { eta: e, k: kk, specular, roughness }, true)
+        }
+        JsonMaterial::Dielectric { ior, alpha, distribution, thin } => {
+            let eta = ior.unwrap_or(1.5);
+            let roughness = if *thin { None } else { roughness(ctx, &at, distribution, *alpha)? };
+            (
+                MaterialModel::Dielectric { eta, reflect: Rgb::WHITE, transmit: Rgb::WHITE, roughness, thin: *thin },
+                false,
+            )
+        }
+        JsonMaterial::Plastic { diffuse, ior, alpha, distribution } => (
+            MaterialModel::Plastic {
+                diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
+                specular: Rgb::WHITE,
+                eta: ior.unwrap_or(1.49),
+                roughness: roughness(ctx, &at, distribution, *alpha)?,
+            },
+            true,
+        ),
+    };
+    Ok(MaterialDesc { name: name.to_string(), model, two_sided, loc: ctx.loc(&at) })
+}
+
+/// Reads a JSON scene (`text` is the file's contents) into a description.
+pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let file: JsonScene = serde_json::from_str(text).map_err(|e| {
+        if e.line() > 0 {
+            Error::at(&SourceLoc::new(path, e.line() as u32, e.column() as u32), strip_position(&e.to_string()))
+        } else {
+            Error::at(&SourceLoc::file(path), e.to_string())
+        }
+    })?;
+    let ctx = Ctx { path, spans: Spans::scan(text), dir: path.parent().unwrap_or(Path::new(".")).to_path_buf() };
+
+    let cam = &file.camera;
+    let to_world =
+        Transform::look_at(Vec3::from_array(cam.position), Vec3::from_array(cam.look_at), Vec3::from_array(cam.up))
+            .ok_or_else(|| {
+                ctx.err("camera", "camera: position equals look_at, or up is parallel to the view direction")
+            })?;
+    let fov_axis: FovAxis = match &cam.fov_axis {
+        Some(a) => a.parse().map_err(|e: String| ctx.err("camera/fov_axis", e))?,
+        None => FovAxis::Y,
+    };
+    let focus_distance = match cam.focus_distance {
+        Some(f) => f,
+        None => (Vec3::from_array(cam.look_at) - Vec3::from_array(cam.position)).length(),
+    };
+    let camera = CameraDesc {
+        to_world: Some(to_world.m.0),
+        fov_degrees: cam.fov,
+        fov_axis,
+        lens_radius: cam.aperture_radius,
+        focus_distance,
+        near_clip: 0.0,
+        far_clip: f32::MAX,
+        loc: ctx.loc("camera"),
+    };
+    let filter = match file.film.filter.as_deref() {
+        None | Some("box") => PixelFilter::Box,
+        Some("tent") => PixelFilter::Tent { radius: 1.0 },
+        Some("gaussian") => PixelFilter::Gaussian { stddev: 0.5 },
+        Some(other) => return Err(ctx.err("film/filter", format!("unknown filter '{other}' (box, tent, gaussian)"))),
+    };
+    let (width, height) = (file.film.width.min(u32::MAX as u64) as u32, file.film.height.min(u32::MAX as u64) as u32);
+    crate::describe::limits::check_resolution(width, height).map_err(|e| ctx.err("film", e))?;
+    let film = FilmDesc { width, height, filter, loc: ctx.loc("film") };
+    let mut desc = SceneDesc::empty(camera, film);
+    desc.source = Some(path.to_path_buf());
+
+    desc.integrator = match &file.integrator {
+        None => IntegratorDesc::Path(PathSettings::default()),
+        Some(JsonIntegrator::Whitted { max_depth, background }) => IntegratorDesc::Whitted(WhittedSettings {
+            max_depth: match max_depth {
+                Some(d) => narrow(
+                    &ctx,
+                    "integrator/max_depth",
+                    "max_depth",
+                    *d,
+                    1,
+                    crate::describe::limits::MAX_WHITTED_DEPTH as u64,
+                )?,
+                None => 5,
+            },
+            background: background.unwrap_or([0.0; 3]),
+        }),
+        Some(JsonIntegrator::Path {
+            max_depth,
+            rr_depth,
+            rr_probability,
+            strategy,
+            light_selection,
+            hide_emitters,
+        }) => {
+            if let Some(ls) = light_selection {
+                desc.light_selection =
+                    ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
+            }
+            let max_depth = match max_depth {
+                Some(d) if *d < 0 => None,
+                Some(d) => Some(narrow(&ctx, "integrator/max_depth", "max_depth", *d as u64, 0, u32::MAX as u64 - 1)?),
+                None => None,
+            };
+            IntegratorDesc::Path(PathSettings {
+                max_depth,
+                rr_depth: match rr_depth {
+                    Some(d) => narrow(&ctx, "integrator/rr_depth", "rr_depth", *d, 1, u32::MAX as u64 - 1)?,
+                    None => 5,
+                },
+                rr_probability: *rr_probability,
+                strategy: strategy.unwrap_or(Strategy::Mis),
+                hide_emitters: *hide_emitters,
+            })
+        }
+    };
+    desc.sampler = SamplerDesc {
+        kind: match file.sampler.kind.as_deref() {
+            None => SamplerKind::default(),
+            Some(k) => k.parse().map_err(|e: String| ctx.err("sampler/type", e))?,
+        },
+        spp: match file.sampler.spp {
+            Some(n) => narrow(&ctx, "sampler/spp", "spp", n, 1, crate::describe::limits::MAX_SPP as u64)?,
+            None => 16,
+        },
+        seed: file.sampler.seed.unwrap_or(0),
+    };
+
+    for (name, m) in &file.materials {
+        desc.materials.push(material_of(&ctx, name, m)?);
+    }
+    for (name, m) in &file.meshes {
+        desc.meshes.push(MeshFileDesc {
+            name: name.clone(),
+            file: ctx.resolve(&m.file),
+            face_normals: m.face_normals,
+            loc: ctx.loc(&format!("meshes/{name}")),
+        });
+    }
+
+    for (i, s) in file.shapes.iter().enumerate() {
+        let at = format!("shapes/{i}");
+        let here = |msg: String| ctx.err(&at, format!("shape {i} ({}): {msg}", s.kind));
+        let to_world = transform_of(&s.transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?;
+        let emission = s.emission.map(|e| Emission { radiance: e.rgb(), two_sided: s.two_sided_emission });
+        let material =
+            match &s.material {
+                Some(name) => MaterialRef::Index(desc.material_index(name).ok_or_else(|| {
+                    ctx.err(&format!("{at}/material"), format!("shape {i}: unknown material '{name}'"))
+                })?),
+                None if emission.is_some() => MaterialRef::Black,
+                None => MaterialRef::DefaultDiffuse,
+            };
+        let geometry = match s.kind.as_str() {
+            "obj" | "ply" => {
+                let file = s.file.as_ref().ok_or_else(|| here("needs 'file'".into()))?;
+                Geometry::MeshFile { file: ctx.resolve(file), face_normals: s.face_normals }
+            }
+            "instance" => {
+                let name = s.mesh.as_ref().ok_or_else(|| here("needs 'mesh'".into()))?;
+                let mesh = desc
+                    .meshes
+                    .iter()
+                    .position(|m| &m.name == name)
+                    .ok_or_else(|| ctx.err(&format!("{at}/mesh"), format!("unknown mesh '{name}'")))?;
+                Geometry::Instance { mesh }
+            }
+            "sphere" => Geometry::Sphere {
+                center: Vec3::from_array(s.center.unwrap_or([0.0; 3])),
+                radius: s.radius.unwrap_or(1.0),
+            },
+            "rectangle" => Geometry::Rectangle,
+            "cube" => Geometry::Cube,
+            "disk" => Geometry::Disk,
+            other => {
+                return Err(ctx.err(
+                    &format!("{at}/type"),
+                    format!(
+                        "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk)"
+                    ),
+                ))
+            }
+        };
+        let use_mtl = s.material.is_none() && matches!(geometry, Geometry::MeshFile { .. } | Geometry::Instance { .. });
+        desc.shapes.push(ShapeDesc {
+            geometry,
+            to_world,
+            material,
+            use_mtl,
+            emission,
+            flip_normals: s.flip_normals,
+            loc: ctx.loc(&at),
+        });
+    }
+
+    for (i, l) in file.lights.iter().enumerate() {
+        let at = format!("lights/{i}");
+        let light = match l {
+            JsonLight::Point { position, intensity } => {
+                LightKind::Point { position: Vec3::from_array(*position), intensity: intensity.rgb() }
+            }
+            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width } => {
+                let cutoff = cutoff_angle.unwrap_or(20.0);
+                LightKind::Spot {
+                    position: Vec3::from_array(*position),
+                    direction: Vec3::from_array(*target) - Vec3::from_array(*position),
+                    intensity: intensity.rgb(),
+                    cutoff_degrees: cutoff,
+                    beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
+                }
+            }
+            JsonLight::Directional { direction, irradiance } => {
+                LightKind::Directional { direction: Vec3::from_array(*direction), irradiance: irradiance.rgb() }
+            }
+            JsonLight::Constant { radiance } => LightKind::Constant { radiance: radiance.rgb() },
+            JsonLight::Envmap { file, scale, transform } => LightKind::EnvMap {
+                file: ctx.resolve(file),
+                scale: scale.unwrap_or(1.0),
+                to_world: transform_of(transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?,
+            },
+        };
+        desc.lights.push(LightDesc { light, loc: ctx.loc(&at) });
+    }
+    Ok(desc)
+}
+
+/// serde_json appends " at line L column C"; the location is already at the front.
+fn strip_position(msg: &str) -> String {
+    match msg.rfind(" at line ") {
+        Some(i) => msg[..i].to_string(),
+        None => msg.to_string(),
+    }
+}
