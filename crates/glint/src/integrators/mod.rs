@@ -3,8 +3,11 @@
 //! Each integrator has serialisable settings and a per-ray `li`; scheduling of pixels and
 //! threads lives in [`crate::render`], so integrators never see threads.
 
+mod first_hit;
 mod path;
 mod whitted;
+
+pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 
 pub use path::{PathSettings, Strategy};
 pub use whitted::WhittedSettings;
