@@ -50,7 +50,8 @@ pub fn closest_hit_cost(scene: &Scene, ray: &Ray) -> u64 {
     // The same split as Scene::finish: untransformed meshes are flattened, the rest are
     // the top-level tree's primitives, in instance order.
     let is_flat = |i: &crate::scene::Instance| matches!(i.shape, ShapeRef::Mesh(_)) && i.to_world.is_none();
-    let rest: Vec<u32> = (0..scene.instances.len() as u32).filter(|&i| !is_flat(&scene.instances[i as usize])).collect();
+    let rest: Vec<u32> =
+        (0..scene.instances.len() as u32).filter(|&i| !is_flat(&scene.instances[i as usize])).collect();
     for inst in scene.instances.iter().filter(|i| is_flat(i)) {
         if let ShapeRef::Mesh(m) = inst.shape {
             mesh_counting(&scene.meshes[m as usize], &mut r, &mut visits);
@@ -75,15 +76,13 @@ pub fn closest_hit_cost(scene: &Scene, ray: &Ray) -> u64 {
                     hit
                 }
                 // The top level counted this test as its primitive.
-                ShapeRef::Sphere(s) => {
-                    match scene.spheres[s as usize].intersect(r) {
-                        Some(t) => {
-                            r.t_max = t;
-                            true
-                        }
-                        None => false,
+                ShapeRef::Sphere(s) => match scene.spheres[s as usize].intersect(r) {
+                    Some(t) => {
+                        r.t_max = t;
+                        true
                     }
-                }
+                    None => false,
+                },
             }
         });
     }

@@ -27,7 +27,8 @@ pub enum Aov {
 }
 
 impl Aov {
-    pub const ALL: [Aov; 7] = [Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Position, Aov::Variance, Aov::Spp, Aov::BvhCost];
+    pub const ALL: [Aov; 7] =
+        [Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Position, Aov::Variance, Aov::Spp, Aov::BvhCost];
 
     /// The name on the command line and the prefix of the EXR channels.
     pub fn name(self) -> &'static str {

@@ -99,7 +99,8 @@ pub fn encode_film(film: &Film, meta: &FilmMeta) -> Vec<u8> {
         settings: meta.settings.clone(),
     };
     let json = serde_json::to_vec(&header).expect("the header serialises");
-    let mut out = Vec::with_capacity(PREFIX_BYTES + json.len() + p.pixels.len() * PIXEL_BYTES + p.aov_sums.len() * 16 + 8);
+    let mut out =
+        Vec::with_capacity(PREFIX_BYTES + json.len() + p.pixels.len() * PIXEL_BYTES + p.aov_sums.len() * 16 + 8);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
     out.extend_from_slice(&(json.len() as u32).to_le_bytes());

@@ -348,7 +348,8 @@ impl Film {
             let j = self.index(x, y);
             self.pixels[j].add(sums);
             for c in 0..stride {
-                self.aov_sums[j * stride + c] = self.aov_sums[j * stride + c].saturating_add(tile.aov_sums[i * stride + c]);
+                self.aov_sums[j * stride + c] =
+                    self.aov_sums[j * stride + c].saturating_add(tile.aov_sums[i * stride + c]);
             }
         }
     }
