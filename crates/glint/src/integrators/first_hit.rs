@@ -103,3 +103,59 @@ fn mesh_counting(mesh: &crate::geometry::TriangleMesh, ray: &mut Ray, visits: &m
         }
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::BvhSplit;
+    use crate::camera::{Camera, FovAxis};
+    use crate::geometry::quad_mesh;
+    use crate::materials::{Material, MaterialKind, Texture};
+    use crate::math::{vec3, Transform};
+    use crate::scene::{LightSelection, SceneBuilder};
+    use std::sync::Arc;
+
+    /// `n` quads facing +z at z = -1, -2, ... (never the identity, which would not be instanced), added farthest first; instanced (kept
+    /// with their transform) they go in the top-level tree instead of the flat one.
+    fn wall_stack(n: usize, transformed: bool) -> Scene {
+        let mut b = SceneBuilder::new(BvhSplit::Sah);
+        let m = b.add_material(Material::new(
+            "grey",
+            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },
+            true,
+        ));
+        for k in 0..n {
+            let z = -((n - k) as f32);
+            let p = [vec3(-1.0, -1.0, 0.0), vec3(1.0, -1.0, 0.0), vec3(1.0, 1.0, 0.0), vec3(-1.0, 1.0, 0.0)];
+            let xf = Transform::translate(vec3(0.0, 0.0, z));
+            b.add_mesh_instance(&Arc::new(quad_mesh(p, BvhSplit::Sah)), &xf, transformed, m, None, false).unwrap();
+        }
+        let to_world = Transform::look_at(vec3(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y).unwrap();
+        b.finish(Camera::new(to_world, 4, 4, 30.0, FovAxis::Y), LightSelection::Power).unwrap()
+    }
+
+    #[test]
+    fn bvh_cost_counts_what_the_ray_meets() {
+        let towards = Ray::new(vec3(0.1, 0.2, 5.0), vec3(0.0, 0.0, -1.0));
+        let away = Ray::new(vec3(0.1, 0.2, 5.0), vec3(0.0, 0.0, 1.0));
+        for transformed in [false, true] {
+            let one = wall_stack(1, transformed);
+            let five = wall_stack(5, transformed);
+            assert_eq!(closest_hit_cost(&one, &away), 0, "a ray missing every box enters no node");
+            let (c1, c5) = (closest_hit_cost(&one, &towards), closest_hit_cost(&five, &towards));
+            if transformed {
+                // The top-level root, the instance, the mesh's root and a triangle.
+                assert!(c1 >= 4, "{c1}");
+                assert!(c5 >= c1, "one wall {c1}, five walls {c5}");
+            } else {
+                // Flat meshes are traced one after another in instance order, here farthest
+                // first, so each wall costs at least its root and a triangle.
+                assert!(c1 >= 2, "{c1}");
+                assert!(c5 >= c1 + 8, "one wall {c1}, five walls {c5}");
+            }
+            let hit = first_hit(&five, &towards);
+            assert!((hit.depth - 6.0).abs() < 1e-5, "depth {}", hit.depth);
+            assert!((hit.normal - Vec3::Z).length() < 1e-6, "normal {:?}", hit.normal);
+        }
+    }
+}

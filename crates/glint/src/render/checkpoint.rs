@@ -307,10 +307,7 @@ mod tests {
     #[test]
     fn a_huge_header_in_a_small_file_is_an_error_not_an_allocation() {
         // The header is written by hand: a real film of that size would itself be huge.
-        let header = format!(
-            "{{\"width\":65536,\"height\":65536,\"region\":{{\"x0\":0,\"y0\":0,\"x1\":65536,\"y1\":65536}},\
-             \"pass_spp\":1,\"spp\":1,\"aovs\":[],\"blocks\":[],\"scene_hash\":0,\"settings\":\"\"}}"
-        );
+        let header = r#"{"width":65536,"height":65536,"region":{"x0":0,"y0":0,"x1":65536,"y1":65536},"pass_spp":1,"spp":1,"aovs":[],"blocks":[],"scene_hash":0,"settings":""}"#;
         let mut b = Vec::new();
         b.extend_from_slice(MAGIC);
         b.extend_from_slice(&1u32.to_le_bytes());
