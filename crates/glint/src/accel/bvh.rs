@@ -58,6 +58,15 @@ pub struct Bvh {
 pub const SAH_TRAVERSAL_COST: f32 = 1.0;
 pub const SAH_INTERSECT_COST: f32 = 1.0;
 
+/// What one counted traversal visited.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalVisits {
+    /// Nodes whose box the ray entered.
+    pub nodes: u64,
+    /// Primitives tested in the leaves of those nodes.
+    pub primitives: u64,
+}
+
 /// Statistics that `glint info` reports.
 #[derive(Clone, Debug, Default)]
 pub struct BvhStats {
@@ -172,6 +181,47 @@ impl Bvh {
                 }
             }
         }
+    }
+
+    /// Closest-hit traversal like [`Bvh::traverse`], counting the nodes entered and the
+    /// primitives tested into `visits`. Only for statistics (the BVH-cost AOV): the fast
+    /// kernels stay free of counters.
+    pub fn traverse_counting<F: FnMut(u32, &mut Ray) -> bool>(
+        &self,
+        ray: &mut Ray,
+        visits: &mut TraversalVisits,
+        mut hit_prim: F,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let inv_dir = Vec3::ONE / ray.dir;
+        let mut stack = vec![0u32];
+        let mut found = false;
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if node.bounds.intersect(ray, inv_dir).is_none() {
+                continue;
+            }
+            visits.nodes += 1;
+            if node.is_leaf() {
+                for k in node.first..node.first + node.count {
+                    visits.primitives += 1;
+                    found |= hit_prim(self.prim_indices[k as usize], ray);
+                }
+                continue;
+            }
+            let (a, b) = (node.first, node.first + 1);
+            let ta = self.nodes[a as usize].bounds.intersect(ray, inv_dir).unwrap_or(f32::INFINITY);
+            let tb = self.nodes[b as usize].bounds.intersect(ray, inv_dir).unwrap_or(f32::INFINITY);
+            // Far child first on the stack, so the near one is visited first.
+            if ta <= tb {
+                stack.extend([b, a]);
+            } else {
+                stack.extend([a, b]);
+            }
+        }
+        found
     }
 
     /// Any-hit traversal for shadow rays: stops at the first primitive `hit_prim` accepts.

@@ -3,10 +3,12 @@
 //! Each integrator has serialisable settings and a per-ray `li`; scheduling of pixels and
 //! threads lives in the render module, so integrators never see threads.
 
+mod first_hit;
 mod path;
 mod whitted;
 
 pub use crate::describe::{PathSettings, Strategy, WhittedSettings};
+pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 
 use crate::bsdf::Bsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};

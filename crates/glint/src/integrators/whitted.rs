@@ -11,19 +11,93 @@ use crate::sampling::Sampler;
 use crate::world::World;
 
 pub fn li(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
-    trace(s, scene, ray, rng, c, 1)
+    // The recursion of the paper, run on an explicit stack so that any `max_depth` fits:
+    // each frame is a hit waiting for the radiance of a reflected or refracted ray. Rays are
+    // traced depth first, reflection before refraction, and every frame adds its children's
+    // radiance with the same operations in the same order as the recursive form, so the
+    // random numbers and the rounding (and so the image) are those of that form.
+    let mut stack: Vec<Frame> = Vec::new();
+    let mut ray = *ray;
+    'trace: loop {
+        let depth = stack.len() as u32 + 1;
+        let mut value = match shade(s, scene, &ray, rng, c, depth) {
+            Node::Done(l) => l,
+            Node::Branch(frame, child) => {
+                stack.push(frame);
+                ray = child;
+                continue 'trace;
+            }
+        };
+        // Hand the finished radiance to the frames waiting for it.
+        while let Some(frame) = stack.last_mut() {
+            match frame.waiting {
+                Waiting::Reflection { reflect, reflectance, refraction } => {
+                    frame.l += reflect * value * reflectance;
+                    if let Some(r) = refraction {
+                        frame.waiting = Waiting::Refraction { transmit: r.transmit, scale: r.scale };
+                        ray = r.ray;
+                        continue 'trace;
+                    }
+                }
+                Waiting::Refraction { transmit, scale } => frame.l += transmit * value * scale,
+                Waiting::Delta { weight } => frame.l += weight * value,
+            }
+            value = frame.l;
+            stack.pop();
+        }
+        return value;
+    }
 }
 
-fn trace(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Rgb {
+/// A hit whose radiance so far is `l`, waiting for the radiance of a child ray.
+struct Frame {
+    l: Rgb,
+    waiting: Waiting,
+}
+
+#[derive(Clone, Copy)]
+enum Waiting {
+    /// A dielectric's reflected ray, with its refracted ray to follow (unless total
+    /// internal reflection).
+    Reflection {
+        reflect: Rgb,
+        reflectance: f32,
+        refraction: Option<Refraction>,
+    },
+    Refraction {
+        transmit: Rgb,
+        scale: f32,
+    },
+    /// A mirror's (or other delta BSDF's) sampled ray.
+    Delta {
+        weight: Rgb,
+    },
+}
+
+#[derive(Clone, Copy)]
+struct Refraction {
+    ray: Ray,
+    transmit: Rgb,
+    scale: f32,
+}
+
+enum Node {
+    /// The radiance along the ray, with nothing more to trace.
+    Done(Rgb),
+    /// Emission and direct light so far, and the first child ray to trace.
+    Branch(Frame, Ray),
+}
+
+/// Everything the recursive form did at one hit before (and without) recursing.
+fn shade(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Node {
     c.rays += 1;
     let Some(hit) = scene.intersect(ray) else {
         if scene.environment_lights.is_empty() {
-            return Rgb::from_array(s.background);
+            return Node::Done(Rgb::from_array(s.background));
         }
-        return scene
-            .environment_lights
-            .iter()
-            .fold(Rgb::BLACK, |a, &i| a + scene.lights[i as usize].environment(ray.dir));
+        return Node::Done(
+            scene.environment_lights.iter().fold(Rgb::BLACK, |a, &i| a + scene.lights[i as usize].environment(ray.dir)),
+        );
     };
     let si = scene.interaction(ray, &hit);
     let wo_world = -ray.dir;
@@ -40,12 +114,13 @@ fn trace(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
             if can_recurse {
                 let fr = fresnel_dielectric(wo.z, eta);
                 let r_dir = frame.to_world(reflect_local(wo));
-                l += reflect * trace(s, scene, &spawn_ray(&si, r_dir), rng, c, depth + 1) * fr.reflectance;
-                if fr.reflectance < 1.0 {
-                    let t_dir = frame.to_world(refract_local(wo, &fr));
-                    let scale = (1.0 - fr.reflectance) / (fr.eta_ti * fr.eta_ti);
-                    l += transmit * trace(s, scene, &spawn_ray(&si, t_dir), rng, c, depth + 1) * scale;
-                }
+                let refraction = (fr.reflectance < 1.0).then(|| Refraction {
+                    ray: spawn_ray(&si, frame.to_world(refract_local(wo, &fr))),
+                    transmit,
+                    scale: (1.0 - fr.reflectance) / (fr.eta_ti * fr.eta_ti),
+                });
+                let waiting = Waiting::Reflection { reflect, reflectance: fr.reflectance, refraction };
+                return Node::Branch(Frame { l, waiting }, spawn_ray(&si, r_dir));
             }
         }
         _ if bsdf.is_delta() => {
@@ -53,7 +128,8 @@ fn trace(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
             if can_recurse {
                 if let Some(bs) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
                     let dir = frame.to_world(bs.wi);
-                    l += bs.weight * trace(s, scene, &spawn_ray(&si, dir), rng, c, depth + 1);
+                    let waiting = Waiting::Delta { weight: bs.weight };
+                    return Node::Branch(Frame { l, waiting }, spawn_ray(&si, dir));
                 }
             }
         }
@@ -77,5 +153,195 @@ fn trace(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
             }
         }
     }
-    l
+    Node::Done(l)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::BvhSplit;
+    use crate::build::WorldBuilder;
+    use crate::camera::{Camera, FovAxis};
+    use crate::describe::Emission;
+    use crate::geometry::quad_mesh;
+    use crate::lights::LightSelection;
+    use crate::materials::{Material, MaterialKind, Texture};
+    use crate::math::{vec3, Transform, Vec3};
+    use crate::sampling::SamplerKind;
+    use std::sync::Arc;
+
+    /// The recursive form this module had before it was made iterative: the reference.
+    fn li_recursive(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
+        trace(s, scene, ray, rng, c, 1)
+    }
+
+    fn trace(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Rgb {
+        c.rays += 1;
+        let Some(hit) = scene.intersect(ray) else {
+            if scene.environment_lights.is_empty() {
+                return Rgb::from_array(s.background);
+            }
+            return scene
+                .environment_lights
+                .iter()
+                .fold(Rgb::BLACK, |a, &i| a + scene.lights[i as usize].environment(ray.dir));
+        };
+        let si = scene.interaction(ray, &hit);
+        let wo_world = -ray.dir;
+        let mut l = Rgb::BLACK;
+        if let Some(li) = si.light {
+            l += scene.lights[li as usize].emitted(si.ng, ray.dir);
+        }
+        let (bsdf, frame) = shading(scene, &si, wo_world);
+        let wo = frame.to_local(wo_world);
+        let can_recurse = depth < s.max_depth;
+
+        match bsdf {
+            Bsdf::Dielectric { eta, reflect, transmit } => {
+                if can_recurse {
+                    let fr = fresnel_dielectric(wo.z, eta);
+                    let r_dir = frame.to_world(reflect_local(wo));
+                    l += reflect * trace(s, scene, &spawn_ray(&si, r_dir), rng, c, depth + 1) * fr.reflectance;
+                    if fr.reflectance < 1.0 {
+                        let t_dir = frame.to_world(refract_local(wo, &fr));
+                        let scale = (1.0 - fr.reflectance) / (fr.eta_ti * fr.eta_ti);
+                        l += transmit * trace(s, scene, &spawn_ray(&si, t_dir), rng, c, depth + 1) * scale;
+                    }
+                }
+            }
+            _ if bsdf.is_delta() => {
+                // Mirrors (and other delta BSDFs): follow the sampled delta direction.
+                if can_recurse {
+                    if let Some(bs) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
+                        let dir = frame.to_world(bs.wi);
+                        l += bs.weight * trace(s, scene, &spawn_ray(&si, dir), rng, c, depth + 1);
+                    }
+                }
+            }
+            _ => {
+                // Diffuse and glossy: direct light only, one sample per light.
+                for light in &scene.lights {
+                    let Some(ls) = light.sample_li(si.p, rng.next_2d()) else {
+                        continue;
+                    };
+                    if ls.pdf <= 0.0 || ls.radiance.is_black() {
+                        continue;
+                    }
+                    let f = bsdf.eval(wo, frame.to_local(ls.wi));
+                    if f.is_black() {
+                        continue;
+                    }
+                    c.shadow_rays += 1;
+                    if !scene.occluded(&shadow_ray(&si, ls.wi, ls.dist)) {
+                        l += f * ls.radiance / ls.pdf;
+                    }
+                }
+            }
+        }
+        l
+    }
+
+    /// A room with a glass ball, a mirror ball, a mirror wall and an area light.
+    fn scene(width: u32, height: u32) -> World {
+        let mut b = WorldBuilder::new(BvhSplit::Sah);
+        let white = b.add_material(Material::new(
+            "white",
+            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.7)) },
+            true,
+        ));
+        let mirror = b.add_material(Material::new(
+            "mirror",
+            MaterialKind::Conductor { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::splat(0.9) },
+            true,
+        ));
+        let glass = b.add_material(Material::new(
+            "glass",
+            MaterialKind::Dielectric { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+            false,
+        ));
+        let quad = |b: &mut WorldBuilder, p: [Vec3; 4], m: u32, e: Option<Emission>| {
+            let mesh = Arc::new(quad_mesh(p, BvhSplit::Sah));
+            b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, m, e, false).unwrap();
+        };
+        let (a, z) = (2.0, -2.0);
+        quad(&mut b, [vec3(-a, 0.0, a), vec3(a, 0.0, a), vec3(a, 0.0, z), vec3(-a, 0.0, z)], white, None);
+        quad(&mut b, [vec3(-a, 0.0, z), vec3(a, 0.0, z), vec3(a, 3.0, z), vec3(-a, 3.0, z)], mirror, None);
+        let light = b.black_material();
+        let e = Some(Emission { radiance: Rgb::splat(10.0), two_sided: false });
+        quad(
+            &mut b,
+            [vec3(-0.5, 2.9, -0.5), vec3(-0.5, 2.9, 0.5), vec3(0.5, 2.9, 0.5), vec3(0.5, 2.9, -0.5)],
+            light,
+            e,
+        );
+        b.add_sphere(vec3(-0.6, 0.6, 0.0), 0.6, &Transform::IDENTITY, glass, None, false).unwrap();
+        b.add_sphere(vec3(0.8, 0.5, -0.5), 0.5, &Transform::IDENTITY, mirror, None, false).unwrap();
+        let to_world = Transform::look_at(vec3(0.0, 1.5, 4.0), vec3(0.0, 0.8, 0.0), Vec3::Y).unwrap();
+        b.finish(Camera::new(to_world, width, height, 45.0, FovAxis::Y), LightSelection::Power).unwrap()
+    }
+
+    fn radiance(
+        f: fn(&WhittedSettings, &World, &Ray, &mut Sampler, &mut Counters) -> Rgb,
+        s: &WhittedSettings,
+        scene: &World,
+    ) -> (Vec<u32>, u64) {
+        let mut c = Counters::default();
+        let mut bits = Vec::new();
+        for y in 0..scene.camera.height {
+            for x in 0..scene.camera.width {
+                let pixel = (y * scene.camera.width + x) as u64;
+                for sample in 0..2 {
+                    let mut rng = Sampler::new(SamplerKind::Independent, 7, pixel, sample);
+                    let ray = scene.camera.generate_ray(x as f32 + rng.next_f32(), y as f32 + rng.next_f32(), [0.5; 2]);
+                    bits.extend(f(s, scene, &ray, &mut rng, &mut c).to_array().map(f32::to_bits));
+                }
+            }
+        }
+        (bits, c.rays + c.shadow_rays)
+    }
+
+    #[test]
+    fn iterative_form_is_bit_identical_to_the_recursive_one() {
+        let scene = scene(40, 30);
+        for max_depth in [1, 2, 5, 12] {
+            let s = WhittedSettings { max_depth, background: [0.1, 0.2, 0.3] };
+            let (iterative, rays_i) = radiance(li, &s, &scene);
+            let (recursive, rays_r) = radiance(li_recursive, &s, &scene);
+            assert_eq!(rays_i, rays_r, "depth {max_depth}: different ray counts");
+            assert!(iterative == recursive, "depth {max_depth}: images differ");
+            assert!(iterative.iter().any(|&b| b != 0), "depth {max_depth}: black image");
+        }
+    }
+
+    #[test]
+    fn very_deep_recursion_fits_a_small_thread_stack() {
+        // Two facing mirrors with the camera between them: the ray bounces until max_depth.
+        let mut b = WorldBuilder::new(BvhSplit::Sah);
+        let mirror = b.add_material(Material::new(
+            "mirror",
+            MaterialKind::Conductor { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::WHITE },
+            true,
+        ));
+        for z in [-1.0f32, 1.0] {
+            let p = [vec3(-5.0, -5.0, z), vec3(5.0, -5.0, z), vec3(5.0, 5.0, z), vec3(-5.0, 5.0, z)];
+            let mesh = Arc::new(quad_mesh(p, BvhSplit::Sah));
+            b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, mirror, None, false).unwrap();
+        }
+        let to_world = Transform::look_at(Vec3::ZERO, vec3(0.0, 0.0, 1.0), Vec3::Y).unwrap();
+        let scene = b.finish(Camera::new(to_world, 1, 1, 10.0, FovAxis::Y), LightSelection::Power).unwrap();
+        let s = WhittedSettings { max_depth: 3000, background: [0.0; 3] };
+        let rays = std::thread::Builder::new()
+            .stack_size(64 * 1024)
+            .spawn(move || {
+                let mut c = Counters::default();
+                let mut rng = Sampler::new(SamplerKind::Independent, 1, 0, 0);
+                let ray = scene.camera.generate_ray(0.5, 0.5, [0.5; 2]);
+                let _ = li(&s, &scene, &ray, &mut rng, &mut c);
+                c.rays
+            })
+            .unwrap()
+            .join()
+            .expect("no stack overflow");
+        assert_eq!(rays, 3000);
+    }
 }

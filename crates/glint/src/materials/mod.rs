@@ -81,6 +81,21 @@ impl Material {
         )
     }
 
+    /// The reflectance a denoiser wants as its albedo guide: the diffuse texture where
+    /// there is one, the specular tint of metals, the transmission tint of dielectrics.
+    pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
+        match &self.kind {
+            MaterialKind::Diffuse { reflectance } => reflectance.eval(uv),
+            MaterialKind::Phong { kd, ks, .. } => (kd.eval(uv) + *ks).map(|v| v.min(1.0)),
+            MaterialKind::Conductor { specular, .. } | MaterialKind::RoughConductor { specular, .. } => *specular,
+            MaterialKind::Dielectric { transmit, .. }
+            | MaterialKind::RoughDielectric { transmit, .. }
+            | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
+            MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
+            MaterialKind::Black => Rgb::BLACK,
+        }
+    }
+
     #[inline]
     pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {
         match &self.kind {

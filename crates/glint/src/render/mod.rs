@@ -1,18 +1,24 @@
-//! Scheduling: the image is cut into tiles that rayon renders in parallel. Every camera
-//! sample draws its random numbers from a generator keyed by (seed, pixel, sample index),
-//! and each pixel sums its samples in order, so the image is bit-identical whatever the
-//! number of threads.
+//! Scheduling: the image is cut into tiles that rayon renders in parallel, pass after pass,
+//! into a [`Film`]. Every camera sample draws its random numbers from a generator keyed by
+//! (seed, pixel, sample index), and the film's sums are exact (fixed point), so the image is
+//! bit-identical whatever the number of threads, passes, regions or merges.
+
+mod aov;
+pub mod checkpoint;
+pub mod film;
+mod passes;
 
 pub use crate::sampling::PixelFilter;
+pub use aov::{Aov, AovImage};
+pub use checkpoint::{content_hash, read_film, write_film, ContentHash, FilmMeta};
+pub use film::{Block, Film, PixelSums, Rect};
+pub use passes::{relative_error, render_passes, Adaptive, PassOutcome, PassRequest};
 
-use crate::integrators::{Counters, Integrator};
+use crate::integrators::Integrator;
 use crate::io::Image;
-use crate::math::Rgb;
-use crate::sampling::{Sampler, SamplerKind};
+use crate::sampling::SamplerKind;
 use crate::world::World;
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
+use std::sync::atomic::AtomicBool;
 
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
@@ -70,109 +76,24 @@ pub trait Progress: Sync {
 pub struct Silent;
 impl Progress for Silent {}
 
-struct Tile {
-    x0: usize,
-    y0: usize,
-    x1: usize,
-    y1: usize,
-}
-
+/// Renders every sample of every pixel in one call: one pass of `settings.spp` samples
+/// into a film over the whole image (see [`render_passes`] for passes, regions and
+/// cancelling).
 pub fn render(
     scene: &World,
     integrator: &Integrator,
     settings: &RenderSettings,
     progress: &dyn Progress,
 ) -> RenderOutput {
-    let start = Instant::now();
-    let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
-    let ts = settings.tile_size.max(1);
-    let tiles: Vec<Tile> = (0..h.div_ceil(ts))
-        .flat_map(|ty| {
-            (0..w.div_ceil(ts)).map(move |tx| Tile {
-                x0: tx * ts,
-                y0: ty * ts,
-                x1: ((tx + 1) * ts).min(w),
-                y1: ((ty + 1) * ts).min(h),
-            })
-        })
-        .collect();
-    let rays = AtomicU64::new(0);
-    let shadow = AtomicU64::new(0);
-    let discarded = AtomicU64::new(0);
+    let (w, h) = (scene.camera.width, scene.camera.height);
     let spp = settings.spp.max(1);
-
-    let results: Vec<(Vec<Rgb>, Vec<Rgb>)> = tiles
-        .par_iter()
-        .map(|tile| {
-            let mut counters = Counters::default();
-            let mut dropped = 0u64;
-            let n = (tile.x1 - tile.x0) * (tile.y1 - tile.y0);
-            let mut means = Vec::with_capacity(n);
-            let mut vars = Vec::with_capacity(if settings.variance { n } else { 0 });
-            for y in tile.y0..tile.y1 {
-                for x in tile.x0..tile.x1 {
-                    let pixel = (y * w + x) as u64;
-                    let mut sum = [0.0f64; 3];
-                    let mut sum2 = [0.0f64; 3];
-                    for s in 0..spp {
-                        let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
-                        let off = settings.filter.sample(rng.next_2d());
-                        let lens = rng.next_2d();
-                        let ray = scene.camera.generate_ray(x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1], lens);
-                        let mut l = integrator.li(scene, &ray, &mut rng, &mut counters);
-                        if !l.is_finite() || l.r < 0.0 || l.g < 0.0 || l.b < 0.0 {
-                            dropped += 1;
-                            l = Rgb::BLACK;
-                        }
-                        for (k, v) in l.to_array().into_iter().enumerate() {
-                            sum[k] += v as f64;
-                            sum2[k] += v as f64 * v as f64;
-                        }
-                    }
-                    let nf = spp as f64;
-                    let mean = [sum[0] / nf, sum[1] / nf, sum[2] / nf];
-                    means.push(Rgb { r: mean[0] as f32, g: mean[1] as f32, b: mean[2] as f32 });
-                    if settings.variance {
-                        let var = |k: usize| {
-                            if spp > 1 {
-                                ((sum2[k] / nf - mean[k] * mean[k]) * nf / (nf - 1.0)).max(0.0) / nf
-                            } else {
-                                0.0
-                            }
-                        };
-                        vars.push(Rgb { r: var(0) as f32, g: var(1) as f32, b: var(2) as f32 });
-                    }
-                }
-            }
-            rays.fetch_add(counters.rays, Ordering::Relaxed);
-            shadow.fetch_add(counters.shadow_rays, Ordering::Relaxed);
-            discarded.fetch_add(dropped, Ordering::Relaxed);
-            progress.advance(n as u64, counters.rays + counters.shadow_rays);
-            (means, vars)
-        })
-        .collect();
-
-    let mut image = Image::new(w, h);
-    let mut variance = settings.variance.then(|| Image::new(w, h));
-    for (tile, (means, vars)) in tiles.iter().zip(results) {
-        let tw = tile.x1 - tile.x0;
-        for (i, m) in means.into_iter().enumerate() {
-            let (x, y) = (tile.x0 + i % tw, tile.y0 + i / tw);
-            image.pixels[y * w + x] = m;
-        }
-        if let Some(v) = variance.as_mut() {
-            for (i, m) in vars.into_iter().enumerate() {
-                let (x, y) = (tile.x0 + i % tw, tile.y0 + i / tw);
-                v.pixels[y * w + x] = m;
-            }
-        }
+    let mut film = Film::new(w, h, Rect::full(w, h), spp, spp, &[]).expect("the camera has a valid resolution");
+    let request = PassRequest { passes: 0..1, adaptive: None };
+    let outcome = render_passes(scene, integrator, settings, &mut film, &request, &AtomicBool::new(false), progress)
+        .expect("a new film takes its first pass");
+    RenderOutput {
+        image: film.image(),
+        variance: settings.variance.then(|| film.variance_image()),
+        stats: outcome.stats,
     }
-    let stats = RenderStats {
-        seconds: start.elapsed().as_secs_f64(),
-        camera_rays: (w * h) as u64 * spp as u64,
-        rays: rays.into_inner(),
-        shadow_rays: shadow.into_inner(),
-        discarded_samples: discarded.into_inner(),
-    };
-    RenderOutput { image, variance, stats }
 }
