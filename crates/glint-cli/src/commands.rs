@@ -6,6 +6,7 @@ use glint::build::BuildOptions;
 use glint::describe::Strategy;
 use glint::formats::{Define, ReadOptions};
 use glint::lights::LightSelection;
+use glint::render::{Aov, Rect};
 use glint::sampling::SamplerKind;
 use glint::session::Session;
 use std::path::PathBuf;
@@ -21,6 +22,10 @@ pub struct Cli {
 enum Command {
     /// Render a scene (.json, or Mitsuba 3 .xml) to an image (.png, .exr or .pfm).
     Render(RenderArgs),
+    /// Continue a checkpointed render (bit-identical to an uninterrupted one).
+    Resume(ResumeArgs),
+    /// Add films of one render (disjoint passes or regions) and write the image.
+    Merge(MergeArgs),
     /// Print scene statistics: shapes, triangles, lights, BVH quality and memory.
     Info(SceneArgs),
     /// Measure ray throughput (closest hit and occlusion) on a mesh and a ray file.
@@ -81,6 +86,107 @@ pub struct RenderArgs {
     /// Print nothing but errors.
     #[arg(long, short)]
     pub quiet: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Samples per pixel of a pass (default 1; the image does not depend on it).
+    #[arg(long)]
+    pub pass_spp: Option<u32>,
+    /// Render only passes A to B-1 (for splitting a render; see `glint merge`).
+    #[arg(long, value_name = "A..B", value_parser = parse_passes)]
+    pub passes: Option<std::ops::Range<u32>>,
+    /// Render only the pixels X0..X1, Y0..Y1 (X1 and Y1 exclusive).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop)]
+    pub crop: Option<Rect>,
+    /// Extra layers: albedo, normal, depth, position, variance, spp, bvh-cost (comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    pub aov: Vec<Aov>,
+    /// Adaptive sampling: pixels whose relative standard error is under the threshold stop.
+    #[arg(long)]
+    pub adaptive: bool,
+    /// Target relative standard error of a pixel's mean for --adaptive.
+    #[arg(long, default_value_t = 0.02)]
+    pub adaptive_threshold: f32,
+    /// Passes every pixel takes before --adaptive may stop it.
+    #[arg(long, default_value_t = 16)]
+    pub adaptive_min_passes: u32,
+}
+
+/// Options shared by `render` and `resume`: how long to go on and what to write meanwhile.
+#[derive(Args, Clone)]
+pub struct RunArgs {
+    /// Render whole passes until this many seconds have passed, then write what is done.
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// Write the film to FILE every --checkpoint-every seconds and on interrupt (see `glint resume`).
+    #[arg(long, value_name = "FILE")]
+    pub checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+    pub checkpoint_every: f64,
+    /// Rewrite the output image every this many seconds as passes finish (a live preview).
+    #[arg(long, value_name = "SECONDS")]
+    pub write_every: Option<f64>,
+    /// Write the raw film (same format as a checkpoint) when done, for `glint merge`.
+    #[arg(long, value_name = "FILE")]
+    pub film_out: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct ResumeArgs {
+    /// A checkpoint written by `glint render --checkpoint`.
+    pub checkpoint: PathBuf,
+    /// Output image (default: the one the render was writing).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Samples per pixel to reach (default: the render's).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+#[derive(Args)]
+pub struct MergeArgs {
+    /// Films of one render (disjoint passes or pixel regions), from --film-out or --checkpoint.
+    #[arg(required = true)]
+    pub films: Vec<PathBuf>,
+    /// Output image (.png, .exr or .pfm).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write the merged film.
+    #[arg(long, value_name = "FILE")]
+    pub film_out: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+fn parse_passes(s: &str) -> Result<std::ops::Range<u32>, String> {
+    let (a, b) = s.split_once("..").ok_or_else(|| format!("'{s}' is not A..B"))?;
+    let a: u32 = a.trim().parse().map_err(|_| format!("'{a}' is not a pass number"))?;
+    let b: u32 = b.trim().parse().map_err(|_| format!("'{b}' is not a pass number"))?;
+    if a >= b {
+        return Err(format!("{a}..{b} is empty (B must be greater than A)"));
+    }
+    Ok(a..b)
+}
+
+fn parse_crop(s: &str) -> Result<Rect, String> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|t| t.trim().parse::<u32>().map_err(|_| format!("'{t}' is not a pixel coordinate")))
+        .collect::<Result<_, _>>()?;
+    let [x0, y0, x1, y1] = v[..] else { return Err(format!("'{s}' is not X0,Y0,X1,Y1")) };
+    if x0 >= x1 || y0 >= y1 {
+        return Err(format!("crop {s} is empty (need X0 < X1 and Y0 < Y1)"));
+    }
+    Ok(Rect { x0, y0, x1, y1 })
 }
 
 fn parse_split(s: &str) -> Result<BvhSplit, String> {
@@ -95,6 +201,8 @@ fn parse_define(s: &str) -> Result<(String, String), String> {
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Render(a) => crate::render::render_cmd(a),
+        Command::Resume(a) => crate::render::resume_cmd(a),
+        Command::Merge(a) => crate::merge::merge_cmd(a),
         Command::Info(a) => Ok(crate::info::info_cmd(a)?),
         Command::Bench(a) => Ok(crate::bench::bench_cmd(a)?),
         Command::Rays(a) => Ok(crate::rays::rays_cmd(a)?),

@@ -3,17 +3,23 @@
 mod bench;
 mod commands;
 mod info;
+mod merge;
 mod meshsrc;
+mod outputs;
 mod progress;
 mod rays;
 mod render;
+mod signals;
 
 use clap::Parser;
 
 fn main() {
     let cli = commands::Cli::parse();
     if let Err(e) = commands::run(cli) {
-        eprintln!("glint: error: {}", e.message);
+        // An interrupted render has already said what it wrote.
+        if !e.message.is_empty() {
+            eprintln!("glint: error: {}", e.message);
+        }
         std::process::exit(e.code);
     }
 }

@@ -1,55 +1,241 @@
-//! `glint render`: opens the scene through a session, applies the command line's overrides
-//! as edits of its description, checks the output before any sample is taken, renders and
-//! writes the image.
+//! `glint render` and `glint resume`: open the scene through a session, apply the command
+//! line's overrides as edits of its description, check every output before any sample is
+//! taken, render passes into a film (with time limit, checkpoints, previews and Ctrl-C),
+//! and write the image, its layers and the film.
 
-use crate::commands::{CliError, RenderArgs};
+use crate::commands::{CliError, RenderArgs, ResumeArgs, RunArgs};
+use crate::outputs::{output_files, temp_files, write_film_image};
 use crate::progress::ProgressBar;
+use crate::signals;
 use glint::describe::{IntegratorDesc, PathSettings, SceneDesc, WhittedSettings};
-use glint::render::{render, Silent};
+use glint::render::{Adaptive, Film};
+use glint::session::{FilmOptions, RenderControl, RenderReport, Session};
 use std::io::IsTerminal;
-use std::path::Path;
-use std::time::Instant;
+use std::path::{Path, PathBuf};
+
+use std::time::{Duration, Instant};
 
 pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
     glint::io::image_io::ImageFormat::from_path(&a.output)?;
+    if a.adaptive && a.passes.is_some() {
+        return Err("--adaptive cannot be combined with --passes (its decisions need every earlier pass)".into());
+    }
+    if a.adaptive && !(a.adaptive_threshold > 0.0 && a.adaptive_threshold.is_finite()) {
+        return Err(format!("--adaptive-threshold {} must be positive", a.adaptive_threshold).into());
+    }
+    if a.pass_spp == Some(0) {
+        return Err("--pass-spp must be at least 1".into());
+    }
+    check_run_args(&a.run)?;
     set_threads(a.threads, a.quiet)?;
     let start = Instant::now();
     let mut session = a.scene.open()?;
     apply_overrides(session.edit(), &a)?;
-    check_output(&a.output, session.description())?;
+    let desc = session.description();
+    if let Some(c) = &a.crop {
+        if c.x1 > desc.film.width || c.y1 > desc.film.height {
+            return Err(format!("--crop {c} is outside the {}x{} image", desc.film.width, desc.film.height).into());
+        }
+    }
+    for out in output_files(&a.output, &a.aov) {
+        check_output(&out, desc)?;
+    }
+    for f in a.run.checkpoint.iter().chain(&a.run.film_out) {
+        check_output(f, desc)?;
+    }
     if !a.quiet {
-        for w in &session.description().warnings {
+        for w in &desc.warnings {
             eprintln!("glint: warning: {w}");
         }
     }
+    let film = session.new_film(&FilmOptions { pass_spp: a.pass_spp, region: a.crop, aovs: a.aov.clone() })?;
+    if let Some(p) = &a.passes {
+        if p.end > film.pass_count() {
+            return Err(format!("--passes {}..{}: the render has {} passes", p.start, p.end, film.pass_count()).into());
+        }
+    }
+    let adaptive =
+        a.adaptive.then_some(Adaptive { threshold: a.adaptive_threshold, min_passes: a.adaptive_min_passes });
+    let job = Job {
+        scene_name: a.scene.scene.display().to_string(),
+        output: a.output.clone(),
+        run: a.run.clone(),
+        quiet: a.quiet,
+    };
+    run(session, film, a.passes.clone(), adaptive, start, &job)
+}
+
+pub fn resume_cmd(a: ResumeArgs) -> Result<(), CliError> {
+    check_run_args(&a.run)?;
+    set_threads(a.threads, a.quiet)?;
+    let start = Instant::now();
+    let resumed = Session::resume_job(&a.checkpoint)?;
+    let (mut session, mut film) = (resumed.session, resumed.film);
+    let output = match (a.output, resumed.job.output) {
+        (Some(o), _) => o,
+        (None, Some(o)) => o,
+        (None, None) => {
+            return Err(format!("{}: the checkpoint names no output; give -o", a.checkpoint.display()).into())
+        }
+    };
+    glint::io::image_io::ImageFormat::from_path(&output)?;
+    if let Some(spp) = a.spp {
+        if spp == 0 || spp > glint::describe::limits::MAX_SPP {
+            return Err(format!("--spp {spp} is out of range (1 to {})", glint::describe::limits::MAX_SPP).into());
+        }
+        film.set_spp(spp).map_err(|e| CliError::from(format!("--spp {spp}: {e}")))?;
+        session.edit().sampler.spp = spp;
+    }
+    for out in output_files(&output, film.aovs()) {
+        check_output(&out, session.description())?;
+    }
+    // A resumed render goes on checkpointing into the file it came from.
+    let mut run_args = a.run.clone();
+    if run_args.checkpoint.is_none() {
+        run_args.checkpoint = Some(a.checkpoint.clone());
+    }
+    let adaptive = session.adaptive();
+    let name = session.description().source.as_ref().map_or("scene".to_string(), |p| p.display().to_string());
+    let job = Job { scene_name: name, output, run: run_args, quiet: a.quiet };
+    run(session, film, None, adaptive, start, &job)
+}
+
+/// What a render writes and says, apart from the scene.
+struct Job {
+    scene_name: String,
+    output: PathBuf,
+    run: RunArgs,
+    quiet: bool,
+}
+
+fn check_run_args(r: &RunArgs) -> Result<(), CliError> {
+    for (name, v) in [
+        ("--time-limit", r.time_limit),
+        ("--write-every", r.write_every),
+        ("--checkpoint-every", Some(r.checkpoint_every)),
+    ] {
+        if let Some(v) = v {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(format!("{name} {v} must be a positive number of seconds").into());
+            }
+        }
+    }
+    for p in r.checkpoint.iter().chain(&r.film_out) {
+        if glint::io::image_io::ImageFormat::from_path(p).is_ok() {
+            return Err(format!("{}: a film file should not have an image extension", p.display()).into());
+        }
+    }
+    Ok(())
+}
+
+/// The samples per pixel the film holds (over its region, for the passes it has).
+fn film_spp(film: &Film) -> u32 {
+    let mut passes: Vec<u32> = film.blocks().iter().flat_map(|b| b.passes.clone()).collect();
+    passes.sort_unstable();
+    passes.dedup();
+    passes.iter().map(|&p| film.pass_samples(p).len() as u32).sum()
+}
+
+fn run(
+    mut session: Session,
+    mut film: Film,
+    passes: Option<std::ops::Range<u32>>,
+    adaptive: Option<Adaptive>,
+    start: Instant,
+    job: &Job,
+) -> Result<(), CliError> {
     let world = session.world()?;
     let load_s = start.elapsed().as_secs_f64();
-    if !a.quiet && world.lights().is_empty() {
-        eprintln!("glint: warning: {}: the scene has no lights: the image will be black", a.scene.scene.display());
+    if !job.quiet && world.lights().is_empty() {
+        eprintln!("glint: warning: {}: the scene has no lights: the image will be black", job.scene_name);
     }
-    let settings = session.render_settings();
-    let integrator = session.integrator();
-    let camera = world.camera();
-    let show_bar = !a.quiet && std::io::stderr().is_terminal();
-    let bar = ProgressBar::new(camera.width as u64 * camera.height as u64, show_bar);
-    let out = render(&world, &integrator, &settings, if show_bar { &bar } else { &Silent });
+    for t in temp_files(&job.output, film.aovs()) {
+        signals::register_temp(&t);
+    }
+    for f in job.run.checkpoint.iter().chain(&job.run.film_out) {
+        signals::register_temp(&glint::io::layers::temp_path(f));
+    }
+    signals::install();
+
+    let requested = passes.clone().unwrap_or(film.passes_done()..film.pass_count());
+    let show_bar = !job.quiet && std::io::stderr().is_terminal();
+    let bar = ProgressBar::new(film.region().area() * requested.len() as u64, show_bar);
+    let control = RenderControl {
+        passes,
+        adaptive,
+        cancel: &signals::CANCEL,
+        time_limit: job.run.time_limit.map(Duration::from_secs_f64),
+        progress: &bar,
+    };
+    // What a checkpoint records is fixed for the whole render: work it out once.
+    session.set_adaptive(adaptive);
+    let meta = session.film_meta(&film, Some(&job.output))?;
+    let (mut last_checkpoint, mut last_preview) = (Instant::now(), Instant::now());
+    let target = film.spp();
+    let report = session.render(&mut film, &control, &mut |film: &Film| {
+        bar.set_spp(film_spp(film), target);
+        if let Some(ck) = &job.run.checkpoint {
+            if last_checkpoint.elapsed().as_secs_f64() >= job.run.checkpoint_every {
+                glint::render::write_film(ck, film, &meta)?;
+                last_checkpoint = Instant::now();
+            }
+        }
+        if let Some(every) = job.run.write_every {
+            if last_preview.elapsed().as_secs_f64() >= every {
+                write_film_image(film, &job.output, &[])?;
+                last_preview = Instant::now();
+            }
+        }
+        Ok(())
+    })?;
     bar.finish();
-    glint::io::write_image(&out.image, &a.output)?;
-    if !a.quiet {
-        let s = &out.stats;
+    finish(&film, &meta, &report, load_s, job)
+}
+/// Writes what the render produced and says so; a render stopped by a signal writes the
+/// image so far (and the checkpoint) and exits with 128 + the signal's number.
+fn finish(
+    film: &Film,
+    meta: &glint::render::FilmMeta,
+    report: &RenderReport,
+    load_s: f64,
+    job: &Job,
+) -> Result<(), CliError> {
+    let interrupted = signals::received().filter(|_| report.cancelled);
+    write_film_image(film, &job.output, &[])?;
+    for f in job.run.checkpoint.iter().chain(&job.run.film_out) {
+        glint::render::write_film(f, film, meta)?;
+    }
+    let spp = film_spp(film);
+    let written = {
+        let mut w = vec![job.output.display().to_string()];
+        w.extend(job.run.checkpoint.iter().chain(&job.run.film_out).map(|p| p.display().to_string()));
+        w.join(", ")
+    };
+    if let Some(sig) = interrupted {
+        if !job.quiet {
+            eprintln!("glint: interrupted at {spp} of {} spp: wrote {written}", film.spp());
+        }
+        return Err(CliError { message: String::new(), code: signals::exit_code(sig) });
+    }
+    if !job.quiet {
+        let s = &report.stats;
+        let r = film.region();
+        let stop = if report.timed_out {
+            format!(" (time limit reached at {spp} of {} spp)", film.spp())
+        } else {
+            String::new()
+        };
         eprintln!(
-            "glint: {} {}x{} @ {} spp ({}) in {:.3} s (load {:.3} s): {:.1} M rays ({:.2} Mrays/s), {} discarded samples -> {}",
-            a.scene.scene.display(),
-            camera.width,
-            camera.height,
-            settings.spp,
-            integrator.name(),
+            "glint: {} {}x{} @ {} spp in {:.3} s (load {:.3} s): {:.1} M rays ({:.2} Mrays/s), {} discarded samples{stop} -> {written}",
+            job.scene_name,
+            r.width(),
+            r.height(),
+            spp,
             s.seconds,
             load_s,
             (s.rays + s.shadow_rays) as f64 / 1e6,
             s.mrays_per_second(),
             s.discarded_samples,
-            a.output.display()
         );
     }
     Ok(())

@@ -9,7 +9,7 @@
 use crate::math::{Aabb, Ray, Vec3};
 
 /// How the builder chooses splits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum BvhSplit {
     /// Binned surface area heuristic (Wald 2007): the default.
     #[default]

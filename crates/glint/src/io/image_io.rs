@@ -59,8 +59,7 @@ pub fn write_image(img: &Image, path: &Path) -> Result<(), String> {
     if !dir.is_dir() {
         return Err(format!("{}: folder {} does not exist", path.display(), dir.display()));
     }
-    let file_name = path.file_name().and_then(|n| n.to_str()).unwrap_or("image");
-    let tmp = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
+    let tmp = super::layers::temp_path(path);
     let result = match format {
         ImageFormat::Png => write_png(img, &tmp),
         ImageFormat::Exr => write_exr(img, &tmp),

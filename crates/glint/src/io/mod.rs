@@ -1,6 +1,7 @@
 //! File input and output: images and meshes.
 
 pub mod image_io;
+pub mod layers;
 pub mod obj;
 pub mod ply;
 mod texture_file;

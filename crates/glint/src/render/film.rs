@@ -282,6 +282,28 @@ impl Film {
             .unwrap_or(self.pass_count())
     }
 
+    /// Changes the target samples per pixel (resuming to a new `--spp`). Passes already in
+    /// the film must stay whole passes of the same samples under the new count.
+    pub fn set_spp(&mut self, spp: u32) -> Result<(), String> {
+        if spp == 0 {
+            return Err("samples per pixel must be positive".into());
+        }
+        if spp == self.spp {
+            return Ok(());
+        }
+        let end = self.blocks.iter().map(|b| b.passes.end).max().unwrap_or(0);
+        let whole = end.saturating_mul(self.pass_spp);
+        let last_partial = end > 0 && (self.pass_samples(end - 1).len() as u32) < self.pass_spp;
+        if last_partial || spp < whole {
+            return Err(format!(
+                "the film holds passes up to {end} of {} samples each; a new count must be at least {whole} (and the old one ended on a whole pass)",
+                self.pass_spp
+            ));
+        }
+        self.spp = spp;
+        Ok(())
+    }
+
     /// Every pass over every pixel of the region is in.
     pub fn is_complete(&self) -> bool {
         self.passes_done() == self.pass_count()

@@ -17,7 +17,7 @@ use std::time::Instant;
 /// mean is under `threshold` and it has had at least `min_passes` passes. The decision
 /// reads only that pixel's sums, so regions and threads still give the same bits; films
 /// split by pass ranges do not (the later range cannot see the earlier one's sums).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Adaptive {
     pub threshold: f32,
     pub min_passes: u32,

@@ -1,21 +1,105 @@
 //! The session: the one API every front end uses. A session opens a scene (a file or a
 //! description), applies edits to the description, builds the world once (again only after
-//! an edit), and renders it.
+//! an edit), and renders passes of samples into a [`Film`], which it can stop, continue,
+//! save and restore.
+//!
+//! ```no_run
+//! use glint::formats::ReadOptions;
+//! use glint::render::{Film, Silent};
+//! use glint::session::{FilmOptions, RenderControl, Session};
+//! use std::sync::atomic::AtomicBool;
+//!
+//! # fn main() -> Result<(), glint::Error> {
+//! let mut session = Session::open("scenes/cornell-box.json".as_ref(), &ReadOptions::default())?;
+//! session.edit().sampler.spp = 64;
+//! let mut film = session.new_film(&FilmOptions::default())?;
+//!
+//! // Render the first 8 passes (of 1 sample each, the default), then stop.
+//! let cancel = AtomicBool::new(false);
+//! let control = RenderControl { passes: Some(0..8), ..RenderControl::new(&cancel, &Silent) };
+//! session.render(&mut film, &control, &mut |_film| Ok(()))?;
+//! println!("{} of {} passes", film.passes_done(), film.pass_count());
+//!
+//! // Save the film, restore it, and continue to the end: the image is bit-identical to one
+//! // rendered in one go. Setting `cancel` from another thread (a Ctrl-C handler) stops the
+//! // render after the current pass and keeps what is done.
+//! session.save_film("cornell.film".as_ref(), &film, None)?;
+//! let (mut session, mut film) = Session::resume("cornell.film".as_ref())?;
+//! session.render(&mut film, &RenderControl::new(&cancel, &Silent), &mut |_film| Ok(()))?;
+//! glint::io::write_image(&film.image(), "cornell.png".as_ref())?;
+//! # Ok(())
+//! # }
+//! ```
+
+mod job;
+
+pub use job::{RenderJob, JOB_VERSION};
 
 use crate::build::{build, BuildOptions};
 use crate::describe::SceneDesc;
-use crate::error::Error;
+use crate::error::{Error, SourceLoc};
 use crate::formats::{read, ReadOptions};
 use crate::integrators::Integrator;
-use crate::render::RenderSettings;
+use crate::render::{
+    read_film, render_passes, write_film, Adaptive, Aov, ContentHash, Film, FilmMeta, PassRequest, Progress, Rect,
+    RenderSettings, RenderStats,
+};
 use crate::world::World;
-use std::path::Path;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// The samples per pass when none is asked for. The image does not depend on the pass size
+/// (the film's sums are exact), so one sample keeps passes short (Ctrl-C, time limits,
+/// previews and adaptive sampling act after each pass) at a measured cost under 3%
+/// (BENCHMARKS.md).
+pub const DEFAULT_PASS_SPP: u32 = 1;
+
+/// What a new film holds.
+#[derive(Clone, Debug, Default)]
+pub struct FilmOptions {
+    /// Samples per pass (default [`DEFAULT_PASS_SPP`]).
+    pub pass_spp: Option<u32>,
+    /// The pixels to render (default: all).
+    pub region: Option<Rect>,
+    pub aovs: Vec<Aov>,
+}
+
+/// How far a call to [`Session::render`] goes.
+pub struct RenderControl<'a> {
+    /// Passes to render (default: every pass the film lacks, from the first it lacks).
+    pub passes: Option<Range<u32>>,
+    pub adaptive: Option<Adaptive>,
+    /// Set (by a signal handler, say) to stop; the pass under way is dropped.
+    pub cancel: &'a AtomicBool,
+    /// No pass starts after this.
+    pub time_limit: Option<Duration>,
+    pub progress: &'a dyn Progress,
+}
+
+impl<'a> RenderControl<'a> {
+    pub fn new(cancel: &'a AtomicBool, progress: &'a dyn Progress) -> RenderControl<'a> {
+        RenderControl { passes: None, adaptive: None, cancel, time_limit: None, progress }
+    }
+}
+
+/// Why a render stopped, and what it did.
+#[derive(Clone, Debug, Default)]
+pub struct RenderReport {
+    pub passes: Range<u32>,
+    pub cancelled: bool,
+    pub timed_out: bool,
+    pub stats: RenderStats,
+}
 
 pub struct Session {
     desc: SceneDesc,
     build_options: BuildOptions,
     world: Option<Arc<World>>,
+    /// Adaptive settings of the film being rendered (stored in its checkpoints).
+    adaptive: Option<Adaptive>,
 }
 
 impl Session {
@@ -25,7 +109,7 @@ impl Session {
     }
 
     pub fn from_description(desc: SceneDesc) -> Session {
-        Session { desc, build_options: BuildOptions::default(), world: None }
+        Session { desc, build_options: BuildOptions::default(), world: None, adaptive: None }
     }
 
     pub fn description(&self) -> &SceneDesc {
@@ -74,4 +158,167 @@ impl Session {
             ..RenderSettings::default()
         }
     }
+
+    /// An empty film for this scene's resolution and samples per pixel.
+    pub fn new_film(&self, opts: &FilmOptions) -> Result<Film, Error> {
+        let (w, h) = (self.desc.film.width, self.desc.film.height);
+        let region = opts.region.unwrap_or(Rect::full(w, h));
+        Film::new(w, h, region, opts.pass_spp.unwrap_or(DEFAULT_PASS_SPP), self.desc.sampler.spp, &opts.aovs)
+            .map_err(Error::new)
+    }
+
+    /// Renders passes into `film` until the requested passes are in, the time is up or
+    /// `cancel` is set; `after_pass` runs after each pass (checkpoints and previews).
+    pub fn render(
+        &mut self,
+        film: &mut Film,
+        control: &RenderControl,
+        after_pass: &mut dyn FnMut(&Film) -> Result<(), Error>,
+    ) -> Result<RenderReport, Error> {
+        let world = self.world()?;
+        let integrator = self.integrator();
+        let settings = self.render_settings();
+        self.adaptive = control.adaptive;
+        let start = Instant::now();
+        let first = film.passes_done();
+        let passes = control.passes.clone().unwrap_or(first..film.pass_count());
+        let mut report = RenderReport { passes: passes.start..passes.start, ..Default::default() };
+        for pass in passes.clone() {
+            if control.cancel.load(Ordering::Relaxed) {
+                report.cancelled = true;
+                break;
+            }
+            if control.time_limit.is_some_and(|t| start.elapsed() >= t) {
+                report.timed_out = true;
+                break;
+            }
+            let request = PassRequest { passes: pass..pass + 1, adaptive: control.adaptive };
+            let outcome =
+                render_passes(&world, &integrator, &settings, film, &request, control.cancel, control.progress)
+                    .map_err(Error::new)?;
+            add_stats(&mut report.stats, &outcome.stats);
+            if outcome.cancelled {
+                report.cancelled = true;
+                break;
+            }
+            report.passes.end = pass + 1;
+            after_pass(film)?;
+        }
+        report.stats.seconds = start.elapsed().as_secs_f64();
+        Ok(report)
+    }
+
+    /// A hash of everything the image depends on: the description and the bytes of every
+    /// file it reads. A checkpoint of a changed scene is refused by it.
+    pub fn scene_hash(&self) -> Result<u64, Error> {
+        let mut h = ContentHash::new();
+        h.update(serde_json::to_string(&self.desc).expect("a description serialises").as_bytes());
+        for file in self.desc.files() {
+            let bytes =
+                std::fs::read(&file).map_err(|e| Error::at(&SourceLoc::file(&file), format!("cannot read: {e}")))?;
+            h.update(&(bytes.len() as u64).to_le_bytes());
+            h.update(&bytes);
+        }
+        Ok(h.finish())
+    }
+
+    /// The job a film of this session records.
+    pub fn job(&self, film: &Film, output: Option<&Path>) -> RenderJob {
+        RenderJob {
+            version: JOB_VERSION,
+            desc: self.desc.clone(),
+            bvh_split: self.build_options.bvh_split,
+            spp: film.spp(),
+            pass_spp: film.pass_spp(),
+            aovs: film.aovs().to_vec(),
+            adaptive: self.adaptive,
+            output: output.map(Path::to_path_buf),
+        }
+    }
+
+    /// What a checkpoint of `film` records beside its sums.
+    pub fn film_meta(&self, film: &Film, output: Option<&Path>) -> Result<FilmMeta, Error> {
+        Ok(FilmMeta { scene_hash: self.scene_hash()?, settings: self.job(film, output).to_json() })
+    }
+
+    /// Writes the film and what it was rendered with (atomically), for `resume` and `merge`.
+    pub fn save_film(&self, path: &Path, film: &Film, output: Option<&Path>) -> Result<(), Error> {
+        write_film(path, film, &self.film_meta(film, output)?).map_err(Error::new)
+    }
+
+    /// Sets the adaptive settings that checkpoints of the next render record.
+    pub fn set_adaptive(&mut self, adaptive: Option<Adaptive>) {
+        self.adaptive = adaptive;
+    }
+
+    /// Reads a film written by [`Session::save_film`] and reopens its scene, refusing it if
+    /// the scene or any file it reads has changed since.
+    pub fn resume(path: &Path) -> Result<(Session, Film), Error> {
+        let r = Session::resume_job(path)?;
+        Ok((r.session, r.film))
+    }
+
+    /// [`Session::resume`], also giving the job the film records (its output, say).
+    pub fn resume_job(path: &Path) -> Result<Resumed, Error> {
+        let (film, job, hash) = read_film_and_job(path)?;
+        let mut s = Session::from_description(job.desc.clone());
+        s.build_options = BuildOptions { bvh_split: job.bvh_split };
+        s.adaptive = job.adaptive;
+        if s.scene_hash()? != hash {
+            return Err(Error::at(
+                &SourceLoc::file(path),
+                "the scene or a file it reads has changed since this film was written",
+            ));
+        }
+        Ok(Resumed { session: s, film, job })
+    }
+
+    /// The adaptive settings the film was (or is being) rendered with.
+    pub fn adaptive(&self) -> Option<Adaptive> {
+        self.adaptive
+    }
+}
+
+/// A session reopened from a film, the film, and the job it records.
+pub struct Resumed {
+    pub session: Session,
+    pub film: Film,
+    pub job: RenderJob,
+}
+
+/// A film, its job and its scene hash, with errors that name the file.
+pub fn read_film_and_job(path: &Path) -> Result<(Film, RenderJob, u64), Error> {
+    let loc = SourceLoc::file(path);
+    let (film, meta) = read_film(path).map_err(|e| Error::at(&loc, e))?;
+    let job = RenderJob::from_json(&meta.settings).map_err(|e| e.or_at(&loc))?;
+    if job.spp != film.spp() || job.pass_spp != film.pass_spp() || job.aovs != film.aovs() {
+        return Err(Error::at(&loc, "the film's settings do not match its contents"));
+    }
+    Ok((film, job, meta.scene_hash))
+}
+
+/// Adds films of one render (disjoint passes or regions) into one; refuses films of another
+/// scene, other settings, or overlapping work. Returns the sum and its job.
+pub fn merge_films(paths: &[PathBuf]) -> Result<(Film, RenderJob, u64), Error> {
+    let Some(first) = paths.first() else { return Err(Error::new("no films to merge")) };
+    let (mut film, job, hash) = read_film_and_job(first)?;
+    for p in &paths[1..] {
+        let (other, other_job, other_hash) = read_film_and_job(p)?;
+        let loc = SourceLoc::file(p);
+        if other_hash != hash {
+            return Err(Error::at(&loc, format!("a film of another scene than {}", first.display())));
+        }
+        if !job.same_render(&other_job) {
+            return Err(Error::at(&loc, format!("rendered with other settings than {}", first.display())));
+        }
+        film.merge(&other).map_err(|e| Error::at(&loc, e))?;
+    }
+    Ok((film, job, hash))
+}
+
+fn add_stats(total: &mut RenderStats, s: &RenderStats) {
+    total.camera_rays += s.camera_rays;
+    total.rays += s.rays;
+    total.shadow_rays += s.shadow_rays;
+    total.discarded_samples += s.discarded_samples;
 }
