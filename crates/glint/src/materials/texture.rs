@@ -19,9 +19,8 @@ impl Bitmap {
             let img = crate::io::image_io::read_exr(path)?;
             return Ok(Bitmap { width: img.width, height: img.height, pixels: img.pixels });
         }
-        let img = image::open(path).map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
+        let rgb = crate::io::image_io::read_raster(path)?;
         let linear_source = ext == "hdr";
-        let rgb = img.to_rgb32f();
         let (w, h) = (rgb.width() as usize, rgb.height() as usize);
         let pixels = rgb
             .pixels()
