@@ -12,7 +12,9 @@ mod triangle;
 pub mod wide;
 mod wide_mesh;
 
-pub use bvh::{BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
+pub use bvh::{
+    BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, MAX_DEPTH, SAH_DEPTH_LIMIT, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST,
+};
 pub use simd::SimdPath;
 pub use top_level::TopLevelBvh;
 pub use triangle::{intersect_triangle, ShearedRay, TriangleHit};
