@@ -99,7 +99,14 @@ mod tests {
 
     #[test]
     fn synthetic_sizes_outside_the_range_are_clear_errors() {
-        for spec in ["synthetic:99999999999", "synthetic:100000001", "synthetic:0", "synthetic:-5", "synthetic:1e9", "synthetic:"] {
+        for spec in [
+            "synthetic:99999999999",
+            "synthetic:100000001",
+            "synthetic:0",
+            "synthetic:-5",
+            "synthetic:1e9",
+            "synthetic:",
+        ] {
             let e = load(spec).err().unwrap_or_else(|| panic!("{spec} was accepted"));
             assert!(e.contains(spec) && e.contains("from 1 to 100000000"), "{e}");
         }

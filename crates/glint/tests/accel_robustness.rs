@@ -105,14 +105,18 @@ fn trace_everything(tris: &[[Vec3; 3]], rays: &[Ray]) -> Vec<(Ray, Vec<(Option<f
             // The binary reference: safe code, but it must not panic either.
             let sh = ShearedRay::new(ray.dir);
             let mut r = *ray;
-            bvh.traverse(&mut r, |p, r| match intersect_triangle(r, &sh, tris[p as usize][0], tris[p as usize][1], tris[p as usize][2]) {
-                Some(h) => {
-                    r.t_max = h.t;
-                    true
+            bvh.traverse(&mut r, |p, r| {
+                match intersect_triangle(r, &sh, tris[p as usize][0], tris[p as usize][1], tris[p as usize][2]) {
+                    Some(h) => {
+                        r.t_max = h.t;
+                        true
+                    }
+                    None => false,
                 }
-                None => false,
             });
-            bvh.occluded(ray, |p, r| intersect_triangle(r, &sh, tris[p as usize][0], tris[p as usize][1], tris[p as usize][2]).is_some());
+            bvh.occluded(ray, |p, r| {
+                intersect_triangle(r, &sh, tris[p as usize][0], tris[p as usize][1], tris[p as usize][2]).is_some()
+            });
             for path in SimdPath::available() {
                 let (mut r4, mut r8) = (*ray, *ray);
                 let h4 = w4.intersect(&mut r4, path);
@@ -252,10 +256,9 @@ fn instance_box_at_infinity_is_ignored() {
         Aabb { min: Vec3::splat(f32::NAN), max: Vec3::splat(f32::NAN) },
     ];
     let top = TopLevelBvh::build(&boxes, BvhSplit::Sah);
-    for ray in [
-        Ray::new(vec3(0.0, 0.0, -5.0), vec3(0.0, 0.0, 1.0)),
-        Ray::new(vec3(0.0, 0.0, -5.0), vec3(f32::NAN, 0.0, 1.0)),
-    ] {
+    for ray in
+        [Ray::new(vec3(0.0, 0.0, -5.0), vec3(0.0, 0.0, 1.0)), Ray::new(vec3(0.0, 0.0, -5.0), vec3(f32::NAN, 0.0, 1.0))]
+    {
         let mut seen = Vec::new();
         let mut r = ray;
         top.traverse(&mut r, |i, _| {

@@ -89,7 +89,9 @@ fn every_regression_input_loads_or_fails_cleanly() {
             let name = file.file_name().unwrap().to_str().unwrap().to_string();
             match run_case(&format, &file) {
                 Err(why) => failures.push(format!("{format}/{name}: {why}")),
-                Ok(Ok(())) if name.contains(".err.") => failures.push(format!("{format}/{name}: loaded, expected an error")),
+                Ok(Ok(())) if name.contains(".err.") => {
+                    failures.push(format!("{format}/{name}: loaded, expected an error"))
+                }
                 Ok(Err(e)) => {
                     if !e.contains(&name) || e.contains('\n') {
                         failures.push(format!("{format}/{name}: error does not name the file in one line: {e}"));

@@ -140,8 +140,7 @@ fn build_part(refs: &mut [BuildRef], split: BvhSplit, opts: BuildOptions, depth:
         return Part::Built(Subtree { nodes: vec![BvhNode { bounds, first: 0, count: n as u32 }], prims: n as u32 });
     };
     let (left, right) = refs.split_at_mut(mid);
-    let (l, r) =
-        rayon::join(|| build_part(left, split, opts, depth + 1), || build_part(right, split, opts, depth + 1));
+    let (l, r) = rayon::join(|| build_part(left, split, opts, depth + 1), || build_part(right, split, opts, depth + 1));
     let (nodes, prims) = (1 + l.node_count() + r.node_count(), l.prim_count() + r.prim_count());
     Part::Split { bounds, left: Box::new(l), right: Box::new(r), nodes, prims }
 }

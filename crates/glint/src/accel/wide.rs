@@ -30,7 +30,7 @@ const EMPTY_CHILD: u32 = u32::MAX;
 
 #[inline(always)]
 pub fn leaf_ref(first: usize, count: usize) -> u32 {
-    assert!(count >= 1 && count <= MAX_LEAF_ITEMS && first <= FIRST_MASK as usize, "leaf out of range");
+    assert!((1..=MAX_LEAF_ITEMS).contains(&count) && first <= FIRST_MASK as usize, "leaf out of range");
     LEAF_BIT | ((count as u32 - 1) << COUNT_SHIFT) | first as u32
 }
 
@@ -104,7 +104,11 @@ impl NodeRay {
     pub fn new(ray: &Ray) -> NodeRay {
         let inv = [1.0 / ray.dir.x, 1.0 / ray.dir.y, 1.0 / ray.dir.z];
         let neg = |a: usize| inv[a].is_sign_negative() as usize;
-        let traceable = ray.origin.is_finite() && ray.dir.is_finite();
+        // `x - x` is 0 for finite `x` and NaN for ±inf and NaN: branch-free, and cheaper
+        // than six `is_finite` tests on this per-ray path.
+        let (o, d) = (ray.origin, ray.dir);
+        let zero_if_finite = ((o.x - o.x) + (o.y - o.y)) + ((o.z - o.z) + (d.x - d.x)) + ((d.y - d.y) + (d.z - d.z));
+        let traceable = zero_if_finite == 0.0;
         NodeRay {
             o: ray.origin.to_array(),
             inv,
@@ -117,6 +121,7 @@ impl NodeRay {
 
 /// Widening of the far distance that keeps boxes touched exactly by a ray (flat boxes,
 /// rounding) from being missed; the same factor as the binary BVH's slab test.
+#[allow(clippy::excessive_precision)] // the literal of the paper; rounds to 1 + 2 ulp
 pub const FAR_SCALE: f32 = 1.000_000_24;
 
 #[derive(Clone, Debug, Default)]
@@ -234,8 +239,8 @@ impl<const W: usize> WideBvh<W> {
             }
             nodes[wi] = node;
         }
-        // What the traversal's unchecked stack accesses rely on (see `STACK`).
-        assert!(out.depth * (W - 1) + 1 <= STACK, "BVH too deep for the wide traversal stack");
+        // What the traversal's unchecked stack accesses rely on: d(W - 1) + 1 <= STACK.
+        assert!(out.depth * (W - 1) < STACK, "BVH too deep for the wide traversal stack");
         out.nodes = PageBuf::new(nodes);
         out
     }
@@ -366,7 +371,9 @@ impl<const W: usize> WideBvh<W> {
                     cur = unsafe { stack.get_unchecked(sp).assume_init() }.0;
                     continue;
                 }
-            } else {
+            } else if !nr.t_min.is_nan() {
+                // Only the root is reached as a leaf here (hit leaf children are tested in
+                // their parent); an untraceable ray skips it as it would skip its box.
                 let (first, count) = leaf_range(cur);
                 found |= leaf.test(first, count, ray);
             }
@@ -432,7 +439,8 @@ impl<const W: usize> WideBvh<W> {
                     }
                     continue;
                 }
-            } else {
+            } else if !nr.t_min.is_nan() {
+                // The root as a leaf (see `traverse`).
                 let (first, count) = leaf_range(cur);
                 if leaf.test(first, count, ray) {
                     return true;

@@ -105,8 +105,7 @@ impl<const W: usize> TriangleWideBvh<W> {
     }
 
     pub fn bytes(&self) -> usize {
-        self.tree.nodes().len() * std::mem::size_of::<super::wide::WideNode<W>>()
-            + self.blocks.len() * std::mem::size_of::<Tri4>()
+        std::mem::size_of_val(self.tree.nodes()) + self.blocks.len() * std::mem::size_of::<Tri4>()
     }
 
     /// Closest hit with the given path: (triangle, hit); shortens `ray.t_max`.

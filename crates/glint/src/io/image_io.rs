@@ -191,7 +191,9 @@ pub fn decode_raster_bytes(data: &[u8], path: &Path) -> Result<image::Rgb32FImag
     reader.limits(limits);
     let (w, h) = reader.into_dimensions().map_err(cannot)?;
     check_budget(path, w as usize, h as usize, 12)?;
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(data)).with_guessed_format().map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(data))
+        .with_guessed_format()
+        .map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(IMAGE_BUDGET_BYTES);
     reader.limits(limits);

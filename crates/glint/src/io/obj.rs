@@ -221,7 +221,7 @@ pub fn read_mtl(path: &Path) -> Result<Vec<MtlMaterial>, String> {
     let data = super::read_file_bounded(path, super::MAX_MESH_FILE_BYTES)?;
     let text = std::str::from_utf8(&data).map_err(|_| format!("{}: not UTF-8 text", path.display()))?;
     let mut out: Vec<MtlMaterial> = Vec::new();
-    for (line, key, rest) in statements(&text) {
+    for (line, key, rest) in statements(text) {
         if key == "newmtl" {
             out.push(MtlMaterial { name: rest.join(" "), ni: 1.5, dissolve: 1.0, ..Default::default() });
             continue;

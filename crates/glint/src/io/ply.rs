@@ -202,7 +202,8 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                 })
             }
             Some("element") => {
-                let (Some(name), Some(count)) = (parts.get(1), parts.get(2).and_then(|c| c.parse::<usize>().ok())) else {
+                let (Some(name), Some(count)) = (parts.get(1), parts.get(2).and_then(|c| c.parse::<usize>().ok()))
+                else {
                     return Err(format!("{p}:{line_no}: malformed element line (the count must be a whole number)"));
                 };
                 if count > MAX_ELEMENT_COUNT {

@@ -46,8 +46,9 @@ impl Mat4 {
         let mut inv = Mat4::IDENTITY.0;
         for c in 0..4 {
             let pivot = (c..4).max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))?;
-            // Written so that a NaN pivot counts as singular too.
-            if !(a[pivot][c].abs() >= 1e-300) {
+            // A NaN pivot (inf - inf during elimination) counts as singular too.
+            let pivot_size = a[pivot][c].abs();
+            if pivot_size.is_nan() || pivot_size < 1e-300 {
                 return None;
             }
             a.swap(c, pivot);
