@@ -107,6 +107,7 @@ impl NodeRay {
         // `x - x` is 0 for finite `x` and NaN for ±inf and NaN: branch-free, and cheaper
         // than six `is_finite` tests on this per-ray path.
         let (o, d) = (ray.origin, ray.dir);
+        #[allow(clippy::eq_op)] // `x - x` on purpose
         let zero_if_finite = ((o.x - o.x) + (o.y - o.y)) + ((o.z - o.z) + (d.x - d.x)) + ((d.y - d.y) + (d.z - d.z));
         let traceable = zero_if_finite == 0.0;
         NodeRay {
