@@ -11,9 +11,18 @@ pub struct FlatMesh {
     pub indices: Vec<[u32; 3]>,
 }
 
+/// Sizes `synthetic:N` accepts. The upper bound (about 2 GB of vertices and indices) keeps
+/// a typo from exhausting memory (sizes below 8 make the smallest sphere the grid can).
+pub const SYNTHETIC_TRIANGLES: std::ops::RangeInclusive<usize> = 1..=100_000_000;
+
 pub fn load(spec: &str) -> Result<FlatMesh, String> {
     if let Some(n) = spec.strip_prefix("synthetic:") {
-        let n: usize = n.parse().map_err(|_| format!("'{spec}': expected synthetic:TRIANGLES"))?;
+        let (lo, hi) = (SYNTHETIC_TRIANGLES.start(), SYNTHETIC_TRIANGLES.end());
+        let range_err = || format!("'{spec}': the triangle count must be a whole number from {lo} to {hi}");
+        let n: usize = n.parse().map_err(|_| range_err())?;
+        if !SYNTHETIC_TRIANGLES.contains(&n) {
+            return Err(range_err());
+        }
         return Ok(synthetic(n));
     }
     let path = Path::new(spec);
@@ -82,4 +91,25 @@ pub fn write_triangles(m: &FlatMesh, path: &Path) -> Result<(), String> {
         }
     }
     std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn synthetic_sizes_outside_the_range_are_clear_errors() {
+        for spec in [
+            "synthetic:99999999999",
+            "synthetic:100000001",
+            "synthetic:0",
+            "synthetic:-5",
+            "synthetic:1e9",
+            "synthetic:",
+        ] {
+            let e = load(spec).err().unwrap_or_else(|| panic!("{spec} was accepted"));
+            assert!(e.contains(spec) && e.contains("from 1 to 100000000"), "{e}");
+        }
+        assert!(!load("synthetic:8").unwrap().indices.is_empty());
+    }
 }

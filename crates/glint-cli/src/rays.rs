@@ -49,8 +49,12 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     }
 }
 
+/// Most rays `glint rays` writes in one file, and so `glint bench` reads (32 bytes each:
+/// 2 GiB): bounds the allocation that `--count` or a ray file asks for.
+pub const MAX_RAYS: usize = 1 << 26;
+
 pub fn read_rays(path: &Path) -> Result<Vec<Ray>, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let bytes = glint::io::read_file_bounded(path, (MAX_RAYS * 32) as u64)?;
     if bytes.len() % 32 != 0 {
         return Err(format!(
             "{}: size {} is not a multiple of 32 bytes (8 float32 per ray)",
@@ -81,6 +85,9 @@ pub fn write_rays(rays: &[Ray], path: &Path) -> Result<(), String> {
 }
 
 pub fn rays_cmd(a: RaysArgs) -> Result<(), String> {
+    if a.count == 0 || a.count > MAX_RAYS {
+        return Err(format!("--count {}: must be from 1 to {MAX_RAYS}", a.count));
+    }
     let flat = meshsrc::load(&a.mesh)?;
     if let Some(p) = &a.triangles_out {
         meshsrc::write_triangles(&flat, p)?;

@@ -14,6 +14,19 @@ use crate::math::{Aabb, Vec3};
 /// Subtrees above this size are built in parallel.
 const PARALLEL_THRESHOLD: usize = 4096;
 
+/// Depth (the root is 0) from which nodes are split at the object median instead of by the
+/// SAH. The SAH can peel one reference off per level (exponentially spaced boxes, NaN
+/// garbage), so without this a tree could be as deep as it has references; the median
+/// halves the references per level, so at most 32 more levels follow for `u32` indices.
+/// Real scenes stay far shallower (the bunny's SAH tree is about 30 deep), so this changes
+/// no tree that the SAH builds sensibly.
+pub const SAH_DEPTH_LIMIT: usize = 48;
+
+/// Most levels (nodes on a root-to-leaf path) a built tree has: the SAH levels, then at most
+/// 32 median splits of at most 2^32 references, then the leaf. Traversal stacks are sized
+/// from this.
+pub const MAX_DEPTH: usize = SAH_DEPTH_LIMIT + 33;
+
 const PLACEHOLDER: BvhNode = BvhNode { bounds: Aabb::EMPTY, first: 0, count: 0 };
 
 struct BuildRef {
@@ -64,16 +77,20 @@ impl Part {
 
 /// Builds over `bounds[i]` for each primitive `i`: (nodes, primitive indices in leaf order).
 pub fn build(bounds: &[Aabb], split: BvhSplit, opts: BuildOptions) -> (Vec<BvhNode>, Vec<u32>) {
+    assert!(bounds.len() <= u32::MAX as usize, "more primitives than u32 indices can name");
     let mut refs: Vec<BuildRef> = bounds
         .iter()
         .enumerate()
-        .map(|(i, b)| BuildRef {
-            bounds: *b,
-            centre: if b.is_empty() { Vec3::ZERO } else { b.center() },
-            index: i as u32,
+        .map(|(i, b)| {
+            // A box with NaN or infinite corners (garbage geometry, a sphere at 1e39 that is
+            // infinite as f32) is treated as empty: it is never hit, and it cannot spread
+            // NaN or infinity into its ancestors' boxes, the bins or the SAH costs.
+            let usable = !b.is_empty() && b.min.is_finite() && b.max.is_finite();
+            let bounds = if usable { *b } else { Aabb::EMPTY };
+            BuildRef { bounds, centre: if usable { b.center() } else { Vec3::ZERO }, index: i as u32 }
         })
         .collect();
-    let part = build_part(&mut refs, split, opts);
+    let part = build_part(&mut refs, split, opts, 0);
     let mut nodes = vec![PLACEHOLDER; part.node_count()];
     // Leaf order is reference order after the build's partitioning.
     let prims = refs.iter().map(|r| r.index).collect();
@@ -110,29 +127,36 @@ fn write(part: Part, nodes: &mut [BvhNode], root: usize, rest: usize, prims_at: 
     }
 }
 
-fn build_part(refs: &mut [BuildRef], split: BvhSplit, opts: BuildOptions) -> Part {
+fn build_part(refs: &mut [BuildRef], split: BvhSplit, opts: BuildOptions, depth: usize) -> Part {
     let n = refs.len();
     if n <= PARALLEL_THRESHOLD {
         let mut tree = Subtree { nodes: Vec::with_capacity(2 * n), prims: 0 };
         tree.nodes.push(PLACEHOLDER);
-        build_in_place(refs, split, opts, 0, &mut tree);
+        build_in_place(refs, split, opts, 0, &mut tree, depth);
         return Part::Built(tree);
     }
     let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| union(b, &r.bounds));
-    let Some(mid) = split_refs(refs, &bounds, split, opts) else {
+    let Some(mid) = split_refs(refs, &bounds, split, opts, depth) else {
         return Part::Built(Subtree { nodes: vec![BvhNode { bounds, first: 0, count: n as u32 }], prims: n as u32 });
     };
     let (left, right) = refs.split_at_mut(mid);
-    let (l, r) = rayon::join(|| build_part(left, split, opts), || build_part(right, split, opts));
+    let (l, r) = rayon::join(|| build_part(left, split, opts, depth + 1), || build_part(right, split, opts, depth + 1));
     let (nodes, prims) = (1 + l.node_count() + r.node_count(), l.prim_count() + r.prim_count());
     Part::Split { bounds, left: Box::new(l), right: Box::new(r), nodes, prims }
 }
 
 /// Builds the node at `tree.nodes[at]` and its subtree sequentially, appending each node's
 /// pair of children as it goes.
-fn build_in_place(refs: &mut [BuildRef], split: BvhSplit, opts: BuildOptions, at: usize, tree: &mut Subtree) {
+fn build_in_place(
+    refs: &mut [BuildRef],
+    split: BvhSplit,
+    opts: BuildOptions,
+    at: usize,
+    tree: &mut Subtree,
+    depth: usize,
+) {
     let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| union(b, &r.bounds));
-    match split_refs(refs, &bounds, split, opts) {
+    match split_refs(refs, &bounds, split, opts, depth) {
         None => {
             tree.nodes[at] = BvhNode { bounds, first: tree.prims, count: refs.len() as u32 };
             tree.prims += refs.len() as u32;
@@ -142,19 +166,28 @@ fn build_in_place(refs: &mut [BuildRef], split: BvhSplit, opts: BuildOptions, at
             tree.nodes[at] = BvhNode { bounds, first: first as u32, count: 0 };
             tree.nodes.extend([PLACEHOLDER, PLACEHOLDER]);
             let (left, right) = refs.split_at_mut(mid);
-            build_in_place(left, split, opts, first, tree);
-            build_in_place(right, split, opts, first + 1, tree);
+            build_in_place(left, split, opts, first, tree, depth + 1);
+            build_in_place(right, split, opts, first + 1, tree, depth + 1);
         }
     }
 }
 
 /// How a node's references divide: `None` makes them a leaf, `Some(mid)` splits them at
-/// `mid`, after reordering them so that the left side comes first.
-fn split_refs(refs: &mut [BuildRef], bounds: &Aabb, split: BvhSplit, opts: BuildOptions) -> Option<usize> {
+/// `mid`, after reordering them so that the left side comes first. From
+/// [`SAH_DEPTH_LIMIT`] on, every split is at the median, so the tree depth stays within
+/// [`MAX_DEPTH`] for any input.
+fn split_refs(
+    refs: &mut [BuildRef],
+    bounds: &Aabb,
+    split: BvhSplit,
+    opts: BuildOptions,
+    depth: usize,
+) -> Option<usize> {
     let n = refs.len();
     if n <= opts.leaf_at_most.max(1) {
         return None;
     }
+    let split = if depth >= SAH_DEPTH_LIMIT { BvhSplit::Median } else { split };
     let centre_bounds = refs.iter().fold(Aabb::EMPTY, |b, r| grow(b, r.centre));
     let axis = centre_bounds.extent().max_axis();
     let extent = centre_bounds.extent()[axis];

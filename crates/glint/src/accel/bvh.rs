@@ -8,6 +8,8 @@
 
 use crate::math::{Aabb, Ray, Vec3};
 
+pub use super::build::{MAX_DEPTH, SAH_DEPTH_LIMIT};
+
 /// How the builder chooses splits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum BvhSplit {
@@ -106,7 +108,8 @@ impl Default for BuildOptions {
 
 impl Bvh {
     /// Builds over `bounds[i]` for each primitive `i`. Empty boxes are allowed (degenerate
-    /// triangles) and end up in leaves that no ray can hit.
+    /// triangles) and end up in leaves that no ray can hit; so do boxes with NaN or infinite
+    /// corners, which are treated as empty. The tree has at most [`MAX_DEPTH`] levels.
     pub fn build(bounds: &[Aabb], split: BvhSplit) -> Bvh {
         Bvh::build_with(bounds, split, BuildOptions::BINARY)
     }
@@ -132,7 +135,8 @@ impl Bvh {
             return false;
         }
         let inv_dir = Vec3::ONE / ray.dir;
-        let mut stack = [0u32; 64];
+        // One far child per level at most: the build bounds the depth by MAX_DEPTH.
+        let mut stack = [0u32; MAX_DEPTH];
         let mut sp = 0usize;
         let mut node_idx = 0u32;
         let mut found = false;
@@ -231,7 +235,8 @@ impl Bvh {
             return false;
         }
         let inv_dir = Vec3::ONE / ray.dir;
-        let mut stack = [0u32; 64];
+        // One pending sibling per level, plus the two children just pushed.
+        let mut stack = [0u32; MAX_DEPTH + 1];
         let mut sp = 0usize;
         stack[sp] = 0;
         sp += 1;

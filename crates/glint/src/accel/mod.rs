@@ -13,7 +13,8 @@ pub mod wide;
 mod wide_mesh;
 
 pub use bvh::{
-    BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, TraversalVisits, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST,
+    BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, TraversalVisits, MAX_DEPTH, SAH_DEPTH_LIMIT, SAH_INTERSECT_COST,
+    SAH_TRAVERSAL_COST,
 };
 pub use simd::SimdPath;
 pub use top_level::{FlatMesh, TopLevelBvh};

@@ -11,7 +11,7 @@
 //! "items" (blocks of four triangles for a mesh, primitive indices for the scene's top
 //! level) that the caller's closure tests.
 
-use super::bvh::{Bvh, BvhNode, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
+use super::bvh::{Bvh, BvhNode, MAX_DEPTH, SAH_INTERSECT_COST, SAH_TRAVERSAL_COST};
 use super::huge_pages::PageBuf;
 use super::simd::Isa;
 use crate::math::{Aabb, Ray};
@@ -24,11 +24,13 @@ const COUNT_SHIFT: u32 = 27;
 const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Most items one leaf can reference.
 pub const MAX_LEAF_ITEMS: usize = 16;
+/// An unused child slot. It has the leaf bit set, but its range is not valid: soundness
+/// rests on no ray ever hitting its empty box, which [`NodeRay::new`] guarantees.
 const EMPTY_CHILD: u32 = u32::MAX;
 
 #[inline(always)]
 pub fn leaf_ref(first: usize, count: usize) -> u32 {
-    assert!(count >= 1 && count <= MAX_LEAF_ITEMS && first <= FIRST_MASK as usize, "leaf out of range");
+    assert!((1..=MAX_LEAF_ITEMS).contains(&count) && first <= FIRST_MASK as usize, "leaf out of range");
     LEAF_BIT | ((count as u32 - 1) << COUNT_SHIFT) | first as u32
 }
 
@@ -76,6 +78,10 @@ impl<const W: usize> WideNode<W> {
 /// Per-ray constants of the box test. `near[a]` is the row of `bounds` that the ray enters
 /// through on axis `a` (min when the direction is positive), `far[a]` the one it leaves by,
 /// so the test needs no min/max per slab.
+///
+/// A ray whose origin or direction is not finite gets `t_min = NaN`, which makes every box
+/// test of every path fail (see [`NodeRay::new`]): such a ray hits nothing. That is what
+/// keeps empty child slots from ever being reported hit (see `EMPTY_CHILD`).
 #[derive(Clone, Copy, Debug)]
 pub struct NodeRay {
     pub o: [f32; 3],
@@ -86,22 +92,37 @@ pub struct NodeRay {
 }
 
 impl NodeRay {
+    /// Why empty slots (min = +inf, max = -inf) are never hit, for every ray:
+    /// - Finite origin and direction: `inv` is non-zero and not NaN (±inf for a zero
+    ///   component), so each near slab is `(±inf - o) * inv = +inf` exactly and each far slab
+    ///   `-inf`: the entry distance is +inf, the exit -inf, and `+inf <= -inf` is false.
+    /// - Otherwise `t_min` is NaN. Every path computes `t_near = max(sx, max(sy, max(sz,
+    ///   t_min)))` with `maxps` semantics (the second operand when either is NaN), so
+    ///   `t_near` is NaN and the ordered comparison `t_near <= t_far` is false for every child.
+    /// - A NaN `t_min` or `t_max` in the ray itself fails the same way.
     #[inline(always)]
     pub fn new(ray: &Ray) -> NodeRay {
         let inv = [1.0 / ray.dir.x, 1.0 / ray.dir.y, 1.0 / ray.dir.z];
         let neg = |a: usize| inv[a].is_sign_negative() as usize;
+        // `x - x` is 0 for finite `x` and NaN for ±inf and NaN: branch-free, and cheaper
+        // than six `is_finite` tests on this per-ray path.
+        let (o, d) = (ray.origin, ray.dir);
+        #[allow(clippy::eq_op)] // `x - x` on purpose
+        let zero_if_finite = ((o.x - o.x) + (o.y - o.y)) + ((o.z - o.z) + (d.x - d.x)) + ((d.y - d.y) + (d.z - d.z));
+        let traceable = zero_if_finite == 0.0;
         NodeRay {
             o: ray.origin.to_array(),
             inv,
             near: [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)],
             far: [3 - 3 * neg(0), 4 - 3 * neg(1), 5 - 3 * neg(2)],
-            t_min: ray.t_min,
+            t_min: if traceable { ray.t_min } else { f32::NAN },
         }
     }
 }
 
 /// Widening of the far distance that keeps boxes touched exactly by a ray (flat boxes,
 /// rounding) from being missed; the same factor as the binary BVH's slab test.
+#[allow(clippy::excessive_precision)] // the literal of the paper; rounds to 1 + 2 ulp
 pub const FAR_SCALE: f32 = 1.000_000_24;
 
 #[derive(Clone, Debug, Default)]
@@ -158,12 +179,18 @@ impl<F: FnMut(u32, u32, &Ray) -> bool> AnyLeaf for FnLeaf<F> {
     }
 }
 
-/// Traversal stack size in entries; a wide tree deeper than this allows is rejected at build.
-const STACK: usize = 512;
+/// Traversal stack size in entries. A node pushes at most W children and pops one of them at
+/// once, so at a node of depth d the stack holds at most (d - 1)(W - 1) entries before it
+/// pushes, W after: d(W - 1) + 1. A wide tree is no deeper than the binary tree it was
+/// collapsed from, which the build keeps within `MAX_DEPTH`; `collapse` checks this.
+const STACK: usize = MAX_DEPTH * 7 + 1;
 
 impl<const W: usize> WideBvh<W> {
     /// Collapses `bvh`. `leaf(first, count)` turns a binary leaf (a range of
     /// `bvh.prim_indices`) into a leaf reference of the wide tree (it may repack the items).
+    ///
+    /// Panics if `bvh` is deeper than `MAX_DEPTH` (never for a tree from `Bvh::build`): the
+    /// traversal stack is sized for that depth.
     pub fn collapse(bvh: &Bvh, mut leaf: impl FnMut(u32, u32) -> u32) -> WideBvh<W> {
         assert!(W == 4 || W == 8);
         let mut out = WideBvh { nodes: PageBuf::default(), root: EMPTY_CHILD, bounds: bvh.bounds(), depth: 0 };
@@ -181,6 +208,9 @@ impl<const W: usize> WideBvh<W> {
         // per node so that siblings' nodes sit together.
         let mut work = vec![(0usize, 0u32, 1usize)];
         while let Some((wi, bi, depth)) = work.pop() {
+            // Checked as we go, so that a hand-made `Bvh` with a cycle fails instead of
+            // looping.
+            assert!(depth <= MAX_DEPTH, "BVH deeper than the traversal stack allows");
             out.depth = out.depth.max(depth);
             let mut kids: Vec<u32> = vec![bvh.nodes[bi as usize].first, bvh.nodes[bi as usize].first + 1];
             while kids.len() < W {
@@ -210,7 +240,8 @@ impl<const W: usize> WideBvh<W> {
             }
             nodes[wi] = node;
         }
-        assert!(out.depth * (W - 1) + 1 < STACK, "BVH too deep for the wide traversal stack");
+        // What the traversal's unchecked stack accesses rely on: d(W - 1) + 1 <= STACK.
+        assert!(out.depth * (W - 1) < STACK, "BVH too deep for the wide traversal stack");
         out.nodes = PageBuf::new(nodes);
         out
     }
@@ -278,7 +309,10 @@ impl<const W: usize> WideBvh<W> {
         let mut found = false;
         loop {
             if cur & LEAF_BIT == 0 {
-                // SAFETY: child references are built by `collapse` and always in range.
+                // SAFETY: `cur` is the root or a child reference without the leaf bit, taken
+                // from a slot whose box was hit; `collapse` writes every such reference as the
+                // index of a node it pushed, and empty slots (whose reference is not an index)
+                // are never hit (see `NodeRay::new`). So `cur < nodes.len()`.
                 let node = unsafe { nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
                 let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
@@ -315,8 +349,9 @@ impl<const W: usize> WideBvh<W> {
                     let base = sp;
                     let mut push = |c: u32, d: f32, sp: &mut usize| {
                         let mut j = *sp;
-                        // SAFETY: entries base..sp were written above, and `collapse`
-                        // rejects trees deep enough to overflow the stack.
+                        // SAFETY: `j - 1 >= base` entries below `sp` were written; `*sp < STACK`
+                        // because the tree is at most `depth` deep and `collapse` checked
+                        // `depth * (W - 1) + 1 <= STACK` (see `STACK`).
                         unsafe {
                             while j > base && stack.get_unchecked(j - 1).assume_init().1 < d {
                                 *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
@@ -333,11 +368,13 @@ impl<const W: usize> WideBvh<W> {
                         push(node.children[i], dist[i], &mut sp);
                     }
                     sp -= 1;
-                    // SAFETY: written by `push`.
+                    // SAFETY: `push` ran at least twice, so `sp` is below the entries it wrote.
                     cur = unsafe { stack.get_unchecked(sp).assume_init() }.0;
                     continue;
                 }
-            } else {
+            } else if !nr.t_min.is_nan() {
+                // Only the root is reached as a leaf here (hit leaf children are tested in
+                // their parent); an untraceable ray skips it as it would skip its box.
                 let (first, count) = leaf_range(cur);
                 found |= leaf.test(first, count, ray);
             }
@@ -347,7 +384,7 @@ impl<const W: usize> WideBvh<W> {
                     return found;
                 }
                 sp -= 1;
-                // SAFETY: every entry below `sp` was written.
+                // SAFETY: entries `0..sp` were written and `sp <= STACK` (see `push`).
                 let (c, d) = unsafe { stack.get_unchecked(sp).assume_init() };
                 if d <= ray.t_max * FAR_SCALE {
                     cur = c;
@@ -373,7 +410,8 @@ impl<const W: usize> WideBvh<W> {
         let mut cur = self.root;
         loop {
             if cur & LEAF_BIT == 0 {
-                // SAFETY: child references are built by `collapse` and always in range.
+                // SAFETY: as in `traverse`: only hit slots' references are followed, and
+                // those are node indices written by `collapse`.
                 let node = unsafe { nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
                 let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
@@ -394,14 +432,16 @@ impl<const W: usize> WideBvh<W> {
                     cur = node.children[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
                     while mask != 0 {
-                        // SAFETY: `collapse` rejects trees deep enough to overflow the stack.
+                        // SAFETY: at most W - 1 entries per level of the current path, so
+                        // `sp < depth * (W - 1) + 1 <= STACK`, which `collapse` checked.
                         unsafe { stack.get_unchecked_mut(sp) }.write(node.children[mask.trailing_zeros() as usize]);
                         sp += 1;
                         mask &= mask - 1;
                     }
                     continue;
                 }
-            } else {
+            } else if !nr.t_min.is_nan() {
+                // The root as a leaf (see `traverse`).
                 let (first, count) = leaf_range(cur);
                 if leaf.test(first, count, ray) {
                     return true;
@@ -411,7 +451,7 @@ impl<const W: usize> WideBvh<W> {
                 return false;
             }
             sp -= 1;
-            // SAFETY: every entry below `sp` was written.
+            // SAFETY: entries `0..sp` were written, and `sp < STACK`.
             cur = unsafe { stack.get_unchecked(sp).assume_init() };
         }
     }

@@ -25,9 +25,13 @@ impl<S: Isa> ClosestLeaf for Closest<'_, S> {
     #[inline(always)]
     fn test(&mut self, first: u32, count: u32, r: &mut Ray) -> bool {
         let mut hit = false;
-        // SAFETY: leaf ranges are built by `build` and always in range; `S` is available
-        // (the only callers are `intersect_generic`'s, which require it).
+        // SAFETY: traversal only passes the ranges of leaf references whose slot was hit;
+        // `build` made each with `leaf_ref(start, n)` right after pushing those `n` blocks,
+        // so the range is inside `blocks`, and empty slots are never hit (see
+        // `NodeRay::new`). `S` is available (the only callers are `intersect_generic`'s,
+        // which require it).
         for b in unsafe { self.blocks.get_unchecked(first as usize..(first + count) as usize) } {
+            // SAFETY: `S` is available (see above); the kernel reads only `b` and `self.tr`.
             let h = unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) };
             if let Some(lane) = h.nearest() {
                 r.t_max = h.t[lane];
@@ -49,11 +53,12 @@ struct Any<'a, S> {
 impl<S: Isa> AnyLeaf for Any<'_, S> {
     #[inline(always)]
     fn test(&mut self, first: u32, count: u32, r: &Ray) -> bool {
-        // SAFETY: as for `Closest`.
+        // SAFETY: as for `Closest`: hit leaf ranges lie inside `blocks`.
         let blocks = unsafe { self.blocks.get_unchecked(first as usize..(first + count) as usize) };
         // A plain loop: `Iter::any` was compiled as a separate function, called per leaf
         // from outside the AVX2 entry point (perf showed it apart from the traversal).
         for b in blocks {
+            // SAFETY: `S` is available (see `Closest`).
             if unsafe { S::tri4(b, &self.tr, r.t_min, r.t_max) }.mask != 0 {
                 return true;
             }
@@ -100,8 +105,7 @@ impl<const W: usize> TriangleWideBvh<W> {
     }
 
     pub fn bytes(&self) -> usize {
-        self.tree.nodes().len() * std::mem::size_of::<super::wide::WideNode<W>>()
-            + self.blocks.len() * std::mem::size_of::<Tri4>()
+        std::mem::size_of_val(self.tree.nodes()) + self.blocks.len() * std::mem::size_of::<Tri4>()
     }
 
     /// Closest hit with the given path: (triangle, hit); shortens `ray.t_max`.

@@ -119,18 +119,90 @@ fn write_pfm(img: &Image, path: &Path) -> Result<(), String> {
     f.flush().map_err(|e| e.to_string())
 }
 
+/// Most bytes an image decoder may allocate for one image (as the `image` crate's default
+/// limits): a header that claims more is refused before anything is decoded.
+pub const IMAGE_BUDGET_BYTES: u64 = 512 << 20;
+
+/// Largest image file glint reads.
+pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
+
+/// Checks a `width` x `height` image of `bytes_per_pixel` fits [`IMAGE_BUDGET_BYTES`].
+fn check_budget(path: &Path, width: usize, height: usize, bytes_per_pixel: u64) -> Result<(), String> {
+    let bytes = (width as u64).checked_mul(height as u64).and_then(|n| n.checked_mul(bytes_per_pixel));
+    match bytes {
+        Some(b) if b <= IMAGE_BUDGET_BYTES => Ok(()),
+        _ => Err(format!(
+            "{}: image of {width} x {height} pixels exceeds the {} MiB decoding budget",
+            path.display(),
+            IMAGE_BUDGET_BYTES >> 20
+        )),
+    }
+}
+
 /// Reads the RGB channels of an EXR file (first layer).
 pub fn read_exr(path: &Path) -> Result<Image, String> {
-    let img = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |res, _| self::Image::new(res.width(), res.height()),
-        |img: &mut self::Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            let w = img.width;
-            img.pixels[pos.y() * w + pos.x()] = Rgb { r, g, b };
-        },
-    )
-    .map_err(|e| format!("{}: cannot read EXR: {e}", path.display()))?;
+    let data = super::read_file_bounded(path, MAX_IMAGE_FILE_BYTES)?;
+    read_exr_bytes(&data, path)
+}
+
+/// Decodes an EXR file held in memory; `path` only names it in errors. The headers are read
+/// first and every layer's size is checked against [`IMAGE_BUDGET_BYTES`] (the RGBA f32
+/// pixels the decoder builds, and the `Image` made from them), since the `exr` crate has
+/// no allocation limits of its own.
+pub fn read_exr_bytes(data: &[u8], path: &Path) -> Result<Image, String> {
+    let cannot = |e: exr::error::Error| format!("{}: cannot read EXR: {e}", path.display());
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(data), false).map_err(cannot)?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        check_budget(path, size.width(), size.height(), 16 + 12)?;
+    }
+    // Named functions rather than closures: the reader needs them generic over the
+    // channels' lifetime, which closures do not infer.
+    fn create(res: exr::math::Vec2<usize>, _: &exr::prelude::RgbaChannels) -> Image {
+        Image::new(res.width(), res.height())
+    }
+    fn set(img: &mut Image, pos: exr::math::Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)) {
+        let w = img.width;
+        img.pixels[pos.y() * w + pos.x()] = Rgb { r, g, b };
+    }
+    use exr::prelude::{ReadChannels as _, ReadLayers as _};
+    let img = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(create, set)
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(data))
+        .map_err(cannot)?;
     Ok(img.layer_data.channel_data.pixels)
+}
+
+/// Decodes a PNG, JPEG or Radiance HDR file held in memory (the format guessed from its
+/// contents) to RGB f32 as stored, within [`IMAGE_BUDGET_BYTES`]: the `image` crate's
+/// limits bound its own allocations, and the f32 copy made here is checked before it is made.
+pub fn decode_raster_bytes(data: &[u8], path: &Path) -> Result<image::Rgb32FImage, String> {
+    let cannot = |e: image::ImageError| format!("{}: cannot read image: {e}", path.display());
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(data))
+        .with_guessed_format()
+        .map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(IMAGE_BUDGET_BYTES);
+    reader.limits(limits);
+    let (w, h) = reader.into_dimensions().map_err(cannot)?;
+    check_budget(path, w as usize, h as usize, 12)?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(data))
+        .with_guessed_format()
+        .map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(IMAGE_BUDGET_BYTES);
+    reader.limits(limits);
+    Ok(reader.decode().map_err(cannot)?.to_rgb32f())
+}
+
+/// Reads a PNG, JPEG or HDR file within the decoding budget (see [`decode_raster_bytes`]).
+pub fn read_raster(path: &Path) -> Result<image::Rgb32FImage, String> {
+    let data = super::read_file_bounded(path, MAX_IMAGE_FILE_BYTES)?;
+    decode_raster_bytes(&data, path)
 }
 
 /// Reads any image glint writes (for comparisons in tests and tools): EXR and PFM as
@@ -144,7 +216,12 @@ pub fn read_image(path: &Path) -> Result<Image, String> {
 }
 
 fn read_pfm(path: &Path) -> Result<Image, String> {
-    let data = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let data = super::read_file_bounded(path, MAX_IMAGE_FILE_BYTES)?;
+    read_pfm_bytes(&data, path)
+}
+
+/// Decodes a colour PFM file held in memory; `path` only names it in errors.
+pub fn read_pfm_bytes(data: &[u8], path: &Path) -> Result<Image, String> {
     let bad = || format!("{}: not a colour PFM file", path.display());
     let mut fields = Vec::new();
     let mut pos = 0;
@@ -168,16 +245,23 @@ fn read_pfm(path: &Path) -> Result<Image, String> {
     let w: usize = fields[1].parse().map_err(|_| bad())?;
     let h: usize = fields[2].parse().map_err(|_| bad())?;
     let scale: f32 = fields[3].parse().map_err(|_| bad())?;
-    if data.len() < pos + w * h * 12 {
-        return Err(bad());
+    check_budget(path, w, h, 12)?;
+    // Within the budget, so `w * h * 12` cannot overflow.
+    let body = data.get(pos..).unwrap_or(&[]);
+    if body.len() < w * h * 12 {
+        return Err(format!(
+            "{}: PFM header says {w} x {h} pixels but the file holds only {} bytes of pixels (truncated)",
+            path.display(),
+            body.len()
+        ));
     }
     let mut img = Image::new(w, h);
     for row in 0..h {
         for x in 0..w {
             let mut c = [0.0f32; 3];
             for (k, v) in c.iter_mut().enumerate() {
-                let o = pos + ((row * w + x) * 3 + k) * 4;
-                let b = [data[o], data[o + 1], data[o + 2], data[o + 3]];
+                let o = ((row * w + x) * 3 + k) * 4;
+                let b = [body[o], body[o + 1], body[o + 2], body[o + 3]];
                 *v = if scale < 0.0 { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) };
             }
             img.pixels[(h - 1 - row) * w + x] = Rgb::from_array(c);

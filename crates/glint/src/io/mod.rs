@@ -8,3 +8,29 @@ mod texture_file;
 
 pub use image_io::{read_image, write_image, Image};
 pub use texture_file::read_texture_image;
+
+use std::io::Read;
+use std::path::Path;
+
+/// Largest mesh or material file glint reads (2 GiB).
+pub const MAX_MESH_FILE_BYTES: u64 = 2 << 30;
+
+/// Reads a whole regular file of at most `max_bytes`, so that a path naming a device
+/// (/dev/zero), a pipe or an enormous file ends in a clear error instead of exhausting memory.
+pub fn read_file_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, String> {
+    let file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let meta = file.metadata().map_err(|e| format!("{}: {e}", path.display()))?;
+    if !meta.is_file() {
+        return Err(format!("{}: not a regular file", path.display()));
+    }
+    if meta.len() > max_bytes {
+        return Err(format!("{}: file is {} bytes, more than the {max_bytes} allowed", path.display(), meta.len()));
+    }
+    let mut data = Vec::with_capacity(meta.len() as usize);
+    // `take` also bounds a file that grows while it is read.
+    file.take(max_bytes + 1).read_to_end(&mut data).map_err(|e| format!("{}: {e}", path.display()))?;
+    if data.len() as u64 > max_bytes {
+        return Err(format!("{}: file is larger than the {max_bytes} bytes allowed", path.display()));
+    }
+    Ok(data)
+}

@@ -66,8 +66,17 @@ fn statements(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
 }
 
 pub fn read_obj(path: &Path) -> Result<ObjFile, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    parse_obj(&text, path)
+    let data = super::read_file_bounded(path, super::MAX_MESH_FILE_BYTES)?;
+    parse_obj_bytes(&data, path)
+}
+
+/// Parses an OBJ file held in memory; `path` names it in errors and locates its `mtllib`s.
+pub fn parse_obj_bytes(data: &[u8], path: &Path) -> Result<ObjFile, String> {
+    let text = std::str::from_utf8(data).map_err(|e| {
+        let line = 1 + data[..e.valid_up_to()].iter().filter(|&&c| c == b'\n').count();
+        err(path, line, "not UTF-8 text")
+    })?;
+    parse_obj(text, path)
 }
 
 pub fn parse_obj(text: &str, path: &Path) -> Result<ObjFile, String> {
@@ -208,9 +217,11 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjFile, String> {
 }
 
 pub fn read_mtl(path: &Path) -> Result<Vec<MtlMaterial>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    // Bounded: an `mtllib` line may name anything, /dev/zero included.
+    let data = super::read_file_bounded(path, super::MAX_MESH_FILE_BYTES)?;
+    let text = std::str::from_utf8(&data).map_err(|_| format!("{}: not UTF-8 text", path.display()))?;
     let mut out: Vec<MtlMaterial> = Vec::new();
-    for (line, key, rest) in statements(&text) {
+    for (line, key, rest) in statements(text) {
         if key == "newmtl" {
             out.push(MtlMaterial { name: rest.join(" "), ni: 1.5, dissolve: 1.0, ..Default::default() });
             continue;

@@ -5,6 +5,10 @@
 use crate::math::Vec3;
 use std::path::Path;
 
+/// Most entries one element may declare: vertex and face numbers are `u32`. Counts are
+/// further bounded by the bytes left in the file before anything is allocated.
+pub const MAX_ELEMENT_COUNT: usize = u32::MAX as usize;
+
 #[derive(Clone, Debug, Default)]
 pub struct PlyMesh {
     pub positions: Vec<Vec3>,
@@ -81,6 +85,41 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
+    /// Items the body still holds, in the units that [`Reader::min_len`] measures: tokens
+    /// for ASCII, bytes for binary.
+    fn remaining(&self) -> usize {
+        match self.format {
+            Format::Ascii => self.tokens.len() - self.tok,
+            _ => self.data.len() - self.pos,
+        }
+    }
+
+    /// The least room one value of `ty` takes in the body.
+    fn min_len(&self, ty: Scalar) -> usize {
+        match self.format {
+            Format::Ascii => 1,
+            _ => ty.size(),
+        }
+    }
+
+    /// Reads a list length and checks that the body can hold that many values of `ty`,
+    /// so that a corrupt length can neither allocate nor loop beyond the file.
+    fn read_count(&mut self, ct: Scalar, ty: Scalar, path: &Path) -> Result<usize, String> {
+        let v = self.read(ct, path)?;
+        // Negative, fractional and NaN lengths are all rejected by this one test.
+        if !(v >= 0.0 && v.fract() == 0.0) {
+            return Err(format!("{}: list length {v} is not a count", path.display()));
+        }
+        let n = v as usize;
+        if n.saturating_mul(self.min_len(ty)) > self.remaining() {
+            return Err(format!(
+                "{}: list of {n} values is longer than the rest of the file (truncated or corrupt)",
+                path.display()
+            ));
+        }
+        Ok(n)
+    }
+
     fn read(&mut self, ty: Scalar, path: &Path) -> Result<f64, String> {
         match self.format {
             Format::Ascii => {
@@ -124,10 +163,11 @@ impl Reader<'_> {
 }
 
 pub fn read_ply(path: &Path) -> Result<PlyMesh, String> {
-    let data = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let data = super::read_file_bounded(path, super::MAX_MESH_FILE_BYTES)?;
     parse_ply(&data, path)
 }
 
+/// Parses a PLY file held in memory; `path` only names it in errors.
 pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
     let p = path.display();
     // Header: lines up to "end_header".
@@ -162,9 +202,15 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                 })
             }
             Some("element") => {
-                let (Some(name), Some(count)) = (parts.get(1), parts.get(2).and_then(|c| c.parse().ok())) else {
-                    return Err(format!("{p}:{line_no}: malformed element line"));
+                let (Some(name), Some(count)) = (parts.get(1), parts.get(2).and_then(|c| c.parse::<usize>().ok()))
+                else {
+                    return Err(format!("{p}:{line_no}: malformed element line (the count must be a whole number)"));
                 };
+                if count > MAX_ELEMENT_COUNT {
+                    return Err(format!(
+                        "{p}:{line_no}: element '{name}' has {count} entries, more than the {MAX_ELEMENT_COUNT} allowed"
+                    ));
+                }
                 elements.push(Element { name: name.to_string(), count, props: Vec::new() });
             }
             Some("property") => {
@@ -200,6 +246,19 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
     for el in &elements {
+        // An element of no properties takes no room, whatever its count claims.
+        if el.props.is_empty() {
+            continue;
+        }
+        // Each entry takes at least one value per property: a count that the rest of the
+        // file cannot hold is corrupt, and is refused before it drives any loop or allocation.
+        let min_entry: usize = el.props.iter().map(|pr| r.min_len(pr.list.unwrap_or(pr.ty))).sum();
+        if el.count.saturating_mul(min_entry) > r.remaining() {
+            return Err(format!(
+                "{p}: element '{}' claims {} entries, more than the rest of the file can hold (truncated or corrupt)",
+                el.name, el.count
+            ));
+        }
         let idx = |n: &[&str]| el.props.iter().position(|pr| n.contains(&pr.name.as_str()));
         match el.name.as_str() {
             "vertex" => {
@@ -213,7 +272,7 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                 for _ in 0..el.count {
                     for (k, pr) in el.props.iter().enumerate() {
                         if let Some(ct) = pr.list {
-                            let n = r.read(ct, path)? as usize;
+                            let n = r.read_count(ct, pr.ty, path)?;
                             for _ in 0..n {
                                 r.read(pr.ty, path)?;
                             }
@@ -240,7 +299,7 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                 for f in 0..el.count {
                     for (k, pr) in el.props.iter().enumerate() {
                         if let Some(ct) = pr.list {
-                            let n = r.read(ct, path)? as usize;
+                            let n = r.read_count(ct, pr.ty, path)?;
                             let mut ids = Vec::with_capacity(n);
                             for _ in 0..n {
                                 ids.push(r.read(pr.ty, path)?);
@@ -251,7 +310,8 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                                 }
                                 let nv = mesh.positions.len();
                                 for &i in &ids {
-                                    if i < 0.0 || i as usize >= nv {
+                                    // Also rejects NaN and fractional indices.
+                                    if !(i >= 0.0 && i.fract() == 0.0 && i < nv as f64) {
                                         return Err(format!(
                                             "{p}: face {f} uses vertex {i} but there are {nv} vertices"
                                         ));
@@ -271,7 +331,7 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                 for _ in 0..el.count {
                     for pr in &el.props {
                         if let Some(ct) = pr.list {
-                            let n = r.read(ct, path)? as usize;
+                            let n = r.read_count(ct, pr.ty, path)?;
                             for _ in 0..n {
                                 r.read(pr.ty, path)?;
                             }

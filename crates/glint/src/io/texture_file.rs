@@ -10,9 +10,8 @@ pub fn read_texture_image(path: &Path, raw: bool) -> Result<Image, String> {
     if ext == "exr" {
         return read_exr(path);
     }
-    let img = image::open(path).map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
+    let rgb = super::image_io::read_raster(path)?;
     let linear_source = ext == "hdr";
-    let rgb = img.to_rgb32f();
     let (w, h) = (rgb.width() as usize, rgb.height() as usize);
     let pixels = rgb
         .pixels()

@@ -63,7 +63,9 @@ impl Aabb {
         let tmax = hi(t0.x, t1.x).min(hi(t0.y, t1.y)).min(hi(t0.z, t1.z)).min(ray.t_max);
         // Scale tmax up by 2 ulp-ish so that boxes that are flat in one axis and rays that
         // touch them exactly are not lost to rounding (Ize 2013, "Robust BVH ray traversal").
-        if tmin <= tmax * 1.000_000_24 {
+        #[allow(clippy::excessive_precision)] // as written in the paper; 1 + 2 ulp
+        let widen = 1.000_000_24f32;
+        if tmin <= tmax * widen {
             Some(tmin)
         } else {
             None

@@ -30,13 +30,25 @@ impl Mat4 {
         Mat4(r)
     }
 
-    /// Inverse by Gauss-Jordan elimination with partial pivoting; `None` when singular.
+    /// Whether every entry is finite (no NaN, no infinity).
+    pub fn is_finite(&self) -> bool {
+        self.0.iter().flatten().all(|v| v.is_finite())
+    }
+
+    /// Inverse by Gauss-Jordan elimination with partial pivoting; `None` when singular or
+    /// when the input or the result is not finite (a NaN pivot would otherwise pass the
+    /// singularity test, since every comparison with NaN is false).
     pub fn inverse(&self) -> Option<Mat4> {
+        if !self.is_finite() {
+            return None;
+        }
         let mut a = self.0;
         let mut inv = Mat4::IDENTITY.0;
         for c in 0..4 {
             let pivot = (c..4).max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))?;
-            if a[pivot][c].abs() < 1e-300 {
+            // A NaN pivot (inf - inf during elimination) counts as singular too.
+            let pivot_size = a[pivot][c].abs();
+            if pivot_size.is_nan() || pivot_size < 1e-300 {
                 return None;
             }
             a.swap(c, pivot);
@@ -56,7 +68,8 @@ impl Mat4 {
                 }
             }
         }
-        Some(Mat4(inv))
+        let inv = Mat4(inv);
+        inv.is_finite().then_some(inv)
     }
 }
 
@@ -135,6 +148,11 @@ impl Transform {
     }
     pub fn inverse(&self) -> Transform {
         Transform { m: self.inv, inv: self.m }
+    }
+    /// Whether the matrix and its inverse are finite: what a scene builder should require
+    /// before letting a transform near the acceleration structures.
+    pub fn is_finite(&self) -> bool {
+        self.m.is_finite() && self.inv.is_finite()
     }
     pub fn is_identity(&self) -> bool {
         self.m == Mat4::IDENTITY
@@ -235,6 +253,37 @@ mod tests {
         let tangent = vec3(1.0, 1.0, 0.0);
         let n = vec3(1.0, -1.0, 0.0);
         assert!(t.vector(tangent).dot(t.normal(n)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn non_finite_matrices_are_not_invertible() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for (i, j) in [(0, 0), (1, 2), (2, 3), (3, 3)] {
+                let mut m = Mat4::IDENTITY;
+                m.0[i][j] = bad;
+                assert!(m.inverse().is_none(), "entry ({i}, {j}) = {bad} was inverted");
+                assert!(Transform::from_matrix(m).is_none());
+            }
+        }
+    }
+
+    #[test]
+    fn an_inverse_that_overflows_is_rejected() {
+        // Finite, with a pivot above the singularity threshold, but the inverse's
+        // translation is -1e10 / 1e-300, which overflows f64.
+        let m = Mat4([[1e-300, 0.0, 0.0, 1e10], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]);
+        assert!(m.inverse().is_none());
+        let ok = Mat4([[1e-300, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]);
+        assert!(ok.inverse().is_some_and(|i| i.is_finite()));
+    }
+
+    #[test]
+    fn transform_finiteness_checks_both_matrices() {
+        assert!(Transform::IDENTITY.is_finite());
+        assert!(Transform::translate(vec3(1.0, 2.0, 3.0)).is_finite());
+        assert!(!Transform::translate(vec3(f32::INFINITY, 0.0, 0.0)).is_finite());
+        assert!(!Transform::translate(vec3(0.0, f32::NAN, 0.0)).is_finite());
+        assert!(Transform::look_at(Vec3::ZERO, vec3(0.0, 0.0, 1.0), vec3(f32::INFINITY, 1.0, 0.0)).is_none());
     }
 
     #[test]

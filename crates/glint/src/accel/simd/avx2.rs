@@ -21,6 +21,9 @@ unsafe impl Isa for Avx2 {
         let inv = [_mm256_set1_ps(r.inv[0]), _mm256_set1_ps(r.inv[1]), _mm256_set1_ps(r.inv[2])];
         let (t_min, t_max, scale) = (_mm256_set1_ps(r.t_min), _mm256_set1_ps(t_max), _mm256_set1_ps(FAR_SCALE));
         for c in 0..W / 8 {
+            // SAFETY: `row < 6` (the contract of `Isa::node`) and `8 * c + 8 <= W`; the node
+            // is 32-byte aligned and each row is `W * 4` bytes, a multiple of 32, as the
+            // aligned load needs.
             let slab = |row: usize, a: usize| {
                 _mm256_mul_ps(
                     _mm256_sub_ps(_mm256_load_ps(node.bounds.get_unchecked(row).as_ptr().add(8 * c)), o[a]),

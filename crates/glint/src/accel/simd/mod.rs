@@ -117,7 +117,15 @@ impl std::fmt::Display for SimdPath {
 pub unsafe trait Isa {
     /// Slab test of the ray against the node's W child boxes within `(r.t_min, t_max)`.
     /// Returns the mask of children hit and writes each child's entry distance to `dist`.
+    ///
+    /// # Safety
+    /// The CPU must have this instruction set (see the trait), and `r.near`, `r.far` must
+    /// be rows below 6, as [`NodeRay::new`] makes them. Then memory is safe for every float
+    /// input: the kernel reads only `node` and `r`, and writes only `dist`.
     unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max: f32, dist: &mut [f32; W]) -> u32;
     /// Watertight test of four triangles, bit-identical to `intersect_triangle`.
+    ///
+    /// # Safety
+    /// As for [`Isa::node`]; `r.k` must hold axes below 3, which `TriRay::new` ensures.
     unsafe fn tri4(block: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> Tri4Hits;
 }

@@ -31,6 +31,7 @@ unsafe impl Isa for Scalar {
     #[inline(always)]
     unsafe fn node<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max: f32, dist: &mut [f32; W]) -> u32 {
         let mut mask = 0;
+        #[allow(clippy::needless_range_loop)] // lane `i` of several arrays
         for i in 0..W {
             let slab = |row: usize, a: usize| (node.bounds[row][i] - r.o[a]) * r.inv[a];
             let t_near = max_ps(slab(r.near[0], 0), max_ps(slab(r.near[1], 1), max_ps(slab(r.near[2], 2), r.t_min)));

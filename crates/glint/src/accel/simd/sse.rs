@@ -16,6 +16,8 @@ unsafe impl Isa for Sse {
         let inv = [_mm_set1_ps(r.inv[0]), _mm_set1_ps(r.inv[1]), _mm_set1_ps(r.inv[2])];
         let (t_min, t_max, scale) = (_mm_set1_ps(r.t_min), _mm_set1_ps(t_max), _mm_set1_ps(FAR_SCALE));
         for c in 0..W / 4 {
+            // SAFETY: `node.bounds[row]` is checked; `4 * c + 4 <= W`; the node is 32-byte
+            // aligned and each row is `W * 4` bytes, a multiple of 16, as the aligned load needs.
             let slab = |row: usize, a: usize| {
                 _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[row].as_ptr().add(4 * c)), o[a]), inv[a])
             };
