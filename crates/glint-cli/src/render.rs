@@ -352,11 +352,7 @@ pub fn check_output(out: &Path, desc: &SceneDesc) -> Result<(), CliError> {
         (Ok(input), Ok(d)) => out.file_name().is_some_and(|n| d.join(n) == input),
         _ => false,
     };
-    let mut inputs = desc.files();
-    if let Some(src) = &desc.source {
-        inputs.push(src.clone());
-    }
-    if let Some(p) = inputs.iter().find(|p| same(p)) {
+    if let Some(p) = desc.files().iter().find(|p| same(p)) {
         return Err(
             format!("{}: the output would overwrite the scene's input file {}", out.display(), p.display()).into()
         );

@@ -30,6 +30,8 @@ pub const IDENTITY: Matrix4 = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0,
 pub struct SceneDesc {
     /// The file the description was read from (`None` when built in code).
     pub source: Option<PathBuf>,
+    /// Files the scene file included (Mitsuba's `<include>`).
+    pub includes: Vec<PathBuf>,
     pub camera: CameraDesc,
     pub film: FilmDesc,
     pub integrator: IntegratorDesc,
@@ -282,6 +284,7 @@ impl SceneDesc {
     pub fn empty(camera: CameraDesc, film: FilmDesc) -> SceneDesc {
         SceneDesc {
             source: None,
+            includes: Vec::new(),
             camera,
             film,
             integrator: IntegratorDesc::Path(PathSettings::default()),
@@ -295,8 +298,8 @@ impl SceneDesc {
         }
     }
 
-    /// Every file the scene reads (meshes, textures, environment maps), in description
-    /// order, each once: what a checkpoint hashes and what a render farm ships.
+    /// Every file the scene reads (the scene file, its includes, meshes, textures,
+    /// environment maps), each once: what a checkpoint hashes and what a render farm ships.
     pub fn files(&self) -> Vec<PathBuf> {
         let mut out: Vec<PathBuf> = Vec::new();
         let mut add = |p: &PathBuf| {
@@ -304,6 +307,9 @@ impl SceneDesc {
                 out.push(p.clone());
             }
         };
+        for p in self.source.iter().chain(&self.includes) {
+            add(p);
+        }
         for m in &self.materials {
             for t in m.model.textures() {
                 if let TextureDesc::Bitmap { file, .. } = t {

@@ -66,7 +66,8 @@ struct Reader<'a> {
 
 pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    let root = xml::load_tree(path, &defines)?;
+    let tree = xml::load_tree(path, &defines)?;
+    let root = tree.root;
     let mut r = Reader {
         named: HashMap::new(),
         material_index: HashMap::new(),
@@ -106,6 +107,7 @@ pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     };
     let mut desc = SceneDesc::empty(camera, film);
     desc.source = Some(path.to_path_buf());
+    desc.includes = tree.included;
     desc.integrator = integrator;
     desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp: settings_spp(sensor)?.unwrap_or(16), seed };
     desc.materials = r.materials;

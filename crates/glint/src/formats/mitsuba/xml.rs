@@ -130,11 +130,17 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
     root.ok_or_else(|| Error::at(&SourceLoc::file(path), "empty XML document"))
 }
 
+/// A scene file's tree and the files it included.
+pub struct SceneTree {
+    pub root: Element,
+    pub included: Vec<PathBuf>,
+}
+
 /// Loads a scene file: parses it, expands includes, applies version upgrades, collects
 /// defaults (overridden by `defines`) and substitutes `$name` references.
-pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, Error> {
+pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<SceneTree, Error> {
     let mut root = parse_file(path)?;
-    let mut includes = 0usize;
+    let mut included = Includes::default();
     if root.tag != "scene" {
         return Err(root.err(format!("the root element is <{}>, expected <scene>", root.tag)));
     }
@@ -147,7 +153,7 @@ pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, E
     if major > 3 {
         return Err(root.err(format!("scene version {version} is newer than the 3.x that glint reads")));
     }
-    expand_includes(&mut root, 0, &mut includes)?;
+    expand_includes(&mut root, 0, &mut included)?;
     if major < 2 {
         upgrade_from_v0(&mut root);
     }
@@ -166,18 +172,25 @@ pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<Element, E
         values.insert(k.clone(), v.clone());
     }
     substitute(&mut root, &values)?;
-    Ok(root)
+    Ok(SceneTree { root, included: included.files })
 }
 
-fn expand_includes(el: &mut Element, depth: usize, includes: &mut usize) -> Result<(), Error> {
+/// The files included so far, and how many `<include>`s were expanded in all.
+#[derive(Default)]
+struct Includes {
+    files: Vec<PathBuf>,
+    expanded: usize,
+}
+
+fn expand_includes(el: &mut Element, depth: usize, included: &mut Includes) -> Result<(), Error> {
     if depth > 16 {
         return Err(el.err("includes nested more than 16 deep (a cycle?)"));
     }
     let mut out = Vec::with_capacity(el.children.len());
     for mut c in std::mem::take(&mut el.children) {
         if c.tag == "include" {
-            *includes += 1;
-            if *includes > MAX_INCLUDES {
+            included.expanded += 1;
+            if included.expanded > MAX_INCLUDES {
                 return Err(c.err(format!("more than {MAX_INCLUDES} <include>s in one scene")));
             }
             let name = c.required("filename")?;
@@ -186,14 +199,17 @@ fn expand_includes(el: &mut Element, depth: usize, includes: &mut usize) -> Resu
                 return Err(c.err(format!("included file '{}' does not exist", path.display())));
             }
             let mut inc = parse_file(&path)?;
-            expand_includes(&mut inc, depth + 1, includes)?;
+            if !included.files.contains(&path) {
+                included.files.push(path.clone());
+            }
+            expand_includes(&mut inc, depth + 1, included)?;
             if inc.tag == "scene" {
                 out.extend(inc.children);
             } else {
                 out.push(inc);
             }
         } else {
-            expand_includes(&mut c, depth, includes)?;
+            expand_includes(&mut c, depth, included)?;
             out.push(c);
         }
     }
@@ -241,7 +257,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let p = dir.join("old.xml");
         std::fs::write(&p, text).unwrap();
-        let root = load_tree(&p, &[]).unwrap();
+        let root = load_tree(&p, &[]).unwrap().root;
         let shape = &root.children[0];
         assert_eq!(shape.children[0].attr("name"), Some("to_world"));
         assert_eq!(shape.children[0].children[0].tag, "lookat");
