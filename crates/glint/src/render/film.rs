@@ -389,6 +389,11 @@ impl Film {
         self.converged[i] = true;
     }
 
+    /// The region's sums, row-major, and the adaptive flags, for rendering in place.
+    pub(crate) fn sums_mut(&mut self) -> (&mut [PixelSums], &mut [i128], &[bool]) {
+        (&mut self.pixels, &mut self.aov_sums, &self.converged)
+    }
+
     pub(crate) fn region_sums(&self) -> &[PixelSums] {
         &self.pixels
     }

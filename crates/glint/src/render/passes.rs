@@ -1,8 +1,8 @@
-//! Rendering passes into a [`Film`]: tiles in parallel, per-pixel sums within a tile, then
-//! added to the film. A cancel flag is checked between tiles; a cancelled pass is dropped
-//! whole, so a film only ever holds whole passes.
+//! Rendering passes into a [`Film`]: bands of rows in parallel, each added straight into the
+//! film's sums. A cancel flag is checked between passes, so a film only ever holds whole
+//! passes; with passes of one sample (the default) a cancel takes effect within one pass.
 
-use super::film::{to_fixed, Block, Film, PixelSums, Rect, TileSums};
+use super::film::{to_fixed, Block, Film, PixelSums, Rect};
 use super::{Aov, Progress, RenderSettings, RenderStats};
 use crate::integrators::{closest_hit_cost, first_hit, Counters, Integrator};
 use crate::math::Rgb;
@@ -70,13 +70,16 @@ pub fn render_passes(
     let mut stats = RenderStats::default();
     let mut done = request.passes.start..request.passes.start;
     for pass in request.passes.clone() {
-        let Some(tiles) = render_pass(scene, integrator, settings, film, pass, cancel, progress, &mut stats) else {
+        // Checked between passes only: a pass, once started, is added whole.
+        if cancel.load(Ordering::Relaxed) {
             stats.seconds = start.elapsed().as_secs_f64();
             return Ok(PassOutcome { passes_rendered: done, cancelled: true, stats });
-        };
-        for t in &tiles {
-            film.add_tile(t);
         }
+        let counts = render_pass(scene, integrator, settings, film, pass, progress);
+        stats.camera_rays += counts.camera_rays;
+        stats.rays += counts.counters.rays;
+        stats.shadow_rays += counts.counters.shadow_rays;
+        stats.discarded_samples += counts.discarded;
         film.record_block(Block { region: film.region(), passes: pass..pass + 1 })?;
         if let Some(a) = &request.adaptive {
             mark_converged(film, a);
@@ -87,62 +90,42 @@ pub fn render_passes(
     Ok(PassOutcome { passes_rendered: done, cancelled: false, stats })
 }
 
-/// Tiles of the region, row-major.
-fn tiles(region: Rect, size: u32) -> Vec<Rect> {
-    let size = size.max(1);
-    let mut out = Vec::new();
-    let mut y0 = region.y0;
-    while y0 < region.y1 {
-        let y1 = (y0 + size).min(region.y1);
-        let mut x0 = region.x0;
-        while x0 < region.x1 {
-            let x1 = (x0 + size).min(region.x1);
-            out.push(Rect { x0, y0, x1, y1 });
-            x0 = x1;
-        }
-        y0 = y1;
-    }
-    out
-}
-
-/// One pass: the tiles' sums, or `None` when cancelled.
-#[allow(clippy::too_many_arguments)]
+/// One pass, added straight into the film: the region is cut into bands of `tile_size`
+/// rows that threads take in parallel (each owns its rows of the film's sums), and each band
+/// is rendered tile by tile for locality. The sums are exact, so the order does not matter.
 fn render_pass(
     scene: &World,
     integrator: &Integrator,
     settings: &RenderSettings,
-    film: &Film,
+    film: &mut Film,
     pass: u32,
-    cancel: &AtomicBool,
     progress: &dyn Progress,
-    stats: &mut RenderStats,
-) -> Option<Vec<TileSums>> {
+) -> TileCounts {
     let samples = film.pass_samples(pass);
-    let tile_size = settings.tile_size.clamp(1, u32::MAX as usize) as u32;
-    let results: Vec<Option<(TileSums, TileCounts)>> = tiles(film.region(), tile_size)
-        .par_iter()
-        .map(|&rect| {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            Some(render_tile(scene, integrator, settings, film, rect, samples.clone(), progress))
+    let tile = settings.tile_size.clamp(1, u32::MAX as usize) as u32;
+    let region = film.region();
+    let stride = film.aov_stride();
+    let layers: Vec<(Aov, usize)> =
+        film.aovs().iter().filter_map(|&a| film.aov_offset(a).map(|off| (a, off))).collect();
+    let band_pixels = (tile * region.width()) as usize;
+    let (pixels, aov_sums, converged) = film.sums_mut();
+    let bands = pixels.len().div_ceil(band_pixels);
+    let aov_bands: Vec<&mut [i128]> = if stride == 0 {
+        (0..bands).map(|_| <&mut [i128]>::default()).collect()
+    } else {
+        aov_sums.chunks_mut(band_pixels * stride).collect()
+    };
+    let job = PassJob { scene, integrator, settings, region, tile, samples, layers: &layers, stride, progress };
+    pixels
+        .par_chunks_mut(band_pixels)
+        .zip(aov_bands.into_par_iter())
+        .zip(converged.par_chunks(band_pixels))
+        .enumerate()
+        .map(|(b, ((px, aov), done))| job.band(region.y0 + b as u32 * tile, px, aov, done))
+        .reduce(TileCounts::default, |mut a, b| {
+            a.add(&b);
+            a
         })
-        .collect();
-    let mut out = Vec::with_capacity(results.len());
-    let mut pass_counts = TileCounts::default();
-    for r in results {
-        let (sums, counts) = r?;
-        pass_counts.add(&counts);
-        out.push(sums);
-    }
-    if cancel.load(Ordering::Relaxed) {
-        return None;
-    }
-    stats.camera_rays += pass_counts.camera_rays;
-    stats.rays += pass_counts.counters.rays;
-    stats.shadow_rays += pass_counts.counters.shadow_rays;
-    stats.discarded_samples += pass_counts.discarded;
-    Some(out)
 }
 
 #[derive(Default)]
@@ -161,68 +144,81 @@ impl TileCounts {
     }
 }
 
-fn render_tile(
-    scene: &World,
-    integrator: &Integrator,
-    settings: &RenderSettings,
-    film: &Film,
-    rect: Rect,
+/// What every band of a pass shares.
+struct PassJob<'a> {
+    scene: &'a World,
+    integrator: &'a Integrator,
+    settings: &'a RenderSettings,
+    region: Rect,
+    tile: u32,
     samples: Range<u32>,
-    progress: &dyn Progress,
-) -> (TileSums, TileCounts) {
-    let n = rect.area() as usize;
-    let stride = film.aov_stride();
-    let mut tile = TileSums { rect, pixels: vec![PixelSums::default(); n], aov_sums: vec![0; n * stride] };
-    let mut counts = TileCounts::default();
-    let layers: Vec<(Aov, usize)> =
-        film.aovs().iter().filter_map(|&a| film.aov_offset(a).map(|off| (a, off))).collect();
-    let wants_first_hit = layers.iter().any(|(a, _)| *a != Aov::BvhCost);
-    let width = scene.camera.width as u64;
-    let mut i = 0;
-    for y in rect.y0..rect.y1 {
-        for x in rect.x0..rect.x1 {
-            if film.is_converged(x, y) {
-                i += 1;
+    layers: &'a [(Aov, usize)],
+    stride: usize,
+    progress: &'a dyn Progress,
+}
+
+impl PassJob<'_> {
+    /// Renders the band of rows starting at `y0` into its slices of the film.
+    fn band(&self, y0: u32, pixels: &mut [PixelSums], aov_sums: &mut [i128], converged: &[bool]) -> TileCounts {
+        let w = self.region.width();
+        let y1 = (y0 + self.tile).min(self.region.y1);
+        let mut counts = TileCounts::default();
+        let mut x0 = self.region.x0;
+        while x0 < self.region.x1 {
+            let x1 = (x0 + self.tile).min(self.region.x1);
+            let rays_before = counts.counters.rays + counts.counters.shadow_rays;
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let i = ((y - y0) * w + (x - self.region.x0)) as usize;
+                    if converged[i] {
+                        continue;
+                    }
+                    let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];
+                    self.pixel(x, y, &mut pixels[i], aov, &mut counts);
+                }
+            }
+            let rays = counts.counters.rays + counts.counters.shadow_rays - rays_before;
+            self.progress.advance(((x1 - x0) * (y1 - y0)) as u64, rays);
+            x0 = x1;
+        }
+        counts
+    }
+
+    fn pixel(&self, x: u32, y: u32, sums: &mut PixelSums, aov_sums: &mut [i128], counts: &mut TileCounts) {
+        let (scene, settings) = (self.scene, self.settings);
+        let pixel = y as u64 * scene.camera.width as u64 + x as u64;
+        let wants_first_hit = self.layers.iter().any(|(a, _)| *a != Aov::BvhCost);
+        for s in self.samples.clone() {
+            let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
+            let off = settings.filter.sample(rng.next_2d());
+            let lens = rng.next_2d();
+            let ray = scene.camera.generate_ray(x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1], lens);
+            let mut l = self.integrator.li(scene, &ray, &mut rng, &mut counts.counters);
+            if !l.is_finite() || l.r < 0.0 || l.g < 0.0 || l.b < 0.0 {
+                counts.discarded += 1;
+                l = Rgb::BLACK;
+            }
+            sums.add_sample(l);
+            counts.camera_rays += 1;
+            if self.layers.is_empty() {
                 continue;
             }
-            let pixel = y as u64 * width + x as u64;
-            let sums = &mut tile.pixels[i];
-            let aov_sums = &mut tile.aov_sums[i * stride..(i + 1) * stride];
-            for s in samples.clone() {
-                let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
-                let off = settings.filter.sample(rng.next_2d());
-                let lens = rng.next_2d();
-                let ray = scene.camera.generate_ray(x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1], lens);
-                let mut l = integrator.li(scene, &ray, &mut rng, &mut counts.counters);
-                if !l.is_finite() || l.r < 0.0 || l.g < 0.0 || l.b < 0.0 {
-                    counts.discarded += 1;
-                    l = Rgb::BLACK;
-                }
-                sums.add_sample(l);
-                counts.camera_rays += 1;
-                if layers.is_empty() {
-                    continue;
-                }
-                let hit = if wants_first_hit { first_hit(scene, &ray) } else { crate::integrators::FirstHit::NONE };
-                for &(aov, off) in &layers {
-                    let values: [f32; 3] = match aov {
-                        Aov::Albedo => hit.albedo.to_array(),
-                        Aov::Normal => hit.normal.to_array(),
-                        Aov::Position => hit.position.to_array(),
-                        Aov::Depth => [hit.depth, 0.0, 0.0],
-                        Aov::BvhCost => [closest_hit_cost(scene, &ray) as f32, 0.0, 0.0],
-                        Aov::Variance | Aov::Spp => continue,
-                    };
-                    for c in 0..aov.stored_channels() {
-                        aov_sums[off + c] = aov_sums[off + c].saturating_add(to_fixed(values[c] as f64));
-                    }
+            let hit = if wants_first_hit { first_hit(scene, &ray) } else { crate::integrators::FirstHit::NONE };
+            for &(aov, off) in self.layers {
+                let values: [f32; 3] = match aov {
+                    Aov::Albedo => hit.albedo.to_array(),
+                    Aov::Normal => hit.normal.to_array(),
+                    Aov::Position => hit.position.to_array(),
+                    Aov::Depth => [hit.depth, 0.0, 0.0],
+                    Aov::BvhCost => [closest_hit_cost(scene, &ray) as f32, 0.0, 0.0],
+                    Aov::Variance | Aov::Spp => continue,
+                };
+                for c in 0..aov.stored_channels() {
+                    aov_sums[off + c] = aov_sums[off + c].saturating_add(to_fixed(values[c] as f64));
                 }
             }
-            i += 1;
         }
     }
-    progress.advance(n as u64, counts.counters.rays + counts.counters.shadow_rays);
-    (tile, counts)
 }
 
 /// After a pass, stops the pixels whose mean is known well enough.
