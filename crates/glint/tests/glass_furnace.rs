@@ -95,3 +95,40 @@ fn inside_glass_the_furnace_radiance_is_eta_squared_le() {
     let scene = scene_with(glass(), vec3(0.1, 0.2, -0.3));
     check("inside glass", &scene, ETA * ETA * LE);
 }
+
+/// Russian roulette must judge a path by its throughput without the 1/η² radiance scaling
+/// of refraction (pbrt's and Mitsuba's "eta scale"): that factor is undone when the path
+/// leaves the glass. Judged by the scaled throughput, a path inside glass survives with
+/// probability 1/η² instead of 0.95 (the cap), and each survivor's weight grows by η²: one
+/// such roulette alone gives a single sample a relative variance of η² − 1. With the eta
+/// scale every roulette in this furnace survives with 0.95, so even ten of them on one path
+/// give less than 0.95^-10 − 1 = 0.67. The test takes the pixels that see the sphere and
+/// requires their mean relative variance per sample below half of η² − 1.
+#[test]
+fn russian_roulette_ignores_the_radiance_scaling_of_refraction() {
+    let scene = scene_with(glass(), OUTSIDE);
+    let integrator = Integrator::Path(PathSettings { strategy: Strategy::Bsdf, rr_depth: 1, ..Default::default() });
+    let spp = 256;
+    let out = render_with(&scene, &integrator, spp, 3);
+    let variance = out.variance.as_ref().unwrap();
+    let cam = scene.camera();
+    let mut sum = 0.0f64;
+    let mut n = 0usize;
+    for y in 0..SIZE as usize {
+        for x in 0..SIZE as usize {
+            let ray = cam.generate_ray(x as f32 + 0.5, y as f32 + 0.5, [0.5, 0.5]);
+            let sees_sphere = scene
+                .intersect(&ray)
+                .is_some_and(|h| scene.instances()[h.instance as usize].shape == glint::world::ShapeRef::Sphere(0));
+            if sees_sphere {
+                // Variance of one sample = variance of the mean × samples.
+                sum += variance.get(x, y).r as f64 * spp as f64 / (LE as f64 * LE as f64);
+                n += 1;
+            }
+        }
+    }
+    assert!(n >= 20, "the sphere covers only {n} pixels");
+    let mean = sum / n as f64;
+    let bound = 0.5 * (ETA as f64 * ETA as f64 - 1.0);
+    assert!(mean < bound, "relative variance per sample {mean:.3} on the sphere; roulette inside glass must not count 1/eta^2 (bound {bound:.3})");
+}

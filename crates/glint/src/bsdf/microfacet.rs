@@ -203,6 +203,7 @@ pub fn sample_rough_dielectric(
     let cos_om = wo.dot(wm);
     let fr = fresnel_dielectric(cos_om, eta);
     let (pr, _) = lobe_probabilities(fr.reflectance, reflect, transmit);
+    let mut eta_crossed = 1.0;
     let wi = if u_lobe < pr {
         let wi = wm * (2.0 * cos_om) - wo;
         if wi.z * wo.z <= 0.0 {
@@ -218,6 +219,7 @@ pub fn sample_rough_dielectric(
         if wi.z * wo.z >= 0.0 {
             return None;
         }
+        eta_crossed = fr.eta_ti;
         wi.normalize()
     };
     let pdf = pdf_rough_dielectric(d, eta, reflect, transmit, wo, wi);
@@ -225,5 +227,5 @@ pub fn sample_rough_dielectric(
         return None;
     }
     let value = eval_rough_dielectric(d, eta, reflect, transmit, wo, wi);
-    Some(BsdfSample { wi, weight: value / pdf, pdf, delta: false })
+    Some(BsdfSample { wi, weight: value / pdf, pdf, delta: false, eta: eta_crossed })
 }

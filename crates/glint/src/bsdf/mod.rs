@@ -33,7 +33,7 @@ impl BsdfSample {
         if wi.z <= 0.0 || !(pdf > 0.0) {
             return None;
         }
-        Some(BsdfSample { wi, weight: value / pdf, pdf, delta: false })
+        Some(BsdfSample { wi, weight: value / pdf, pdf, delta: false, eta: 1.0 })
     }
 }
 
@@ -45,6 +45,9 @@ pub struct BsdfSample {
     pub pdf: f32,
     /// A delta lobe was chosen (perfect mirror or refraction).
     pub delta: bool,
+    /// Relative index of refraction crossed (1 for reflection): a refracted sample's
+    /// weight carries the 1/eta^2 radiance scaling, which Russian roulette must not count.
+    pub eta: f32,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -158,7 +161,13 @@ impl Bsdf {
                 if wi.z <= 0.0 {
                     return None;
                 }
-                Some(BsdfSample { wi, weight: *reflectance, pdf: warp::cosine_hemisphere_pdf(wi.z), delta: false })
+                Some(BsdfSample {
+                    wi,
+                    weight: *reflectance,
+                    pdf: warp::cosine_hemisphere_pdf(wi.z),
+                    delta: false,
+                    eta: 1.0,
+                })
             }
             Bsdf::Phong(p) => p.sample(wo, u_lobe, u),
             Bsdf::Conductor { eta, k, specular } => {
@@ -166,7 +175,13 @@ impl Bsdf {
                     return None;
                 }
                 let wi = reflect_local(wo);
-                Some(BsdfSample { wi, weight: *specular * fresnel_conductor(wo.z, *eta, *k), pdf: 1.0, delta: true })
+                Some(BsdfSample {
+                    wi,
+                    weight: *specular * fresnel_conductor(wo.z, *eta, *k),
+                    pdf: 1.0,
+                    delta: true,
+                    eta: 1.0,
+                })
             }
             Bsdf::RoughConductor { dist, .. } => {
                 if wo.z <= 0.0 {
@@ -179,11 +194,11 @@ impl Bsdf {
             Bsdf::Dielectric { eta, reflect, transmit } => {
                 let fr = fresnel_dielectric(wo.z, *eta);
                 if u_lobe < fr.reflectance {
-                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true })
+                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true, eta: 1.0 })
                 } else {
                     let wi = refract_local(wo, &fr);
                     let scale = 1.0 / (fr.eta_ti * fr.eta_ti);
-                    Some(BsdfSample { wi, weight: *transmit * scale, pdf: 1.0, delta: true })
+                    Some(BsdfSample { wi, weight: *transmit * scale, pdf: 1.0, delta: true, eta: fr.eta_ti })
                 }
             }
             Bsdf::ThinDielectric { eta, reflect, transmit } => {
@@ -193,9 +208,9 @@ impl Bsdf {
                     r *= 2.0 / (1.0 + r);
                 }
                 if u_lobe < r {
-                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true })
+                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true, eta: 1.0 })
                 } else {
-                    Some(BsdfSample { wi: -wo, weight: *transmit, pdf: 1.0, delta: true })
+                    Some(BsdfSample { wi: -wo, weight: *transmit, pdf: 1.0, delta: true, eta: 1.0 })
                 }
             }
             Bsdf::RoughDielectric { dist, eta, reflect, transmit } => {

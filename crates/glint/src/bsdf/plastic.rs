@@ -195,6 +195,7 @@ impl PlasticParams {
                         weight: self.specular * (f / ps),
                         pdf: ps,
                         delta: true,
+                        eta: 1.0,
                     });
                 }
                 Some(d) => {
@@ -211,7 +212,7 @@ impl PlasticParams {
                 return None;
             }
             let pdf = (1.0 - ps) * warp::cosine_hemisphere_pdf(wi.z);
-            return Some(BsdfSample { wi, weight: self.diffuse_eval(wo, wi) / pdf, pdf, delta: false });
+            return Some(BsdfSample { wi, weight: self.diffuse_eval(wo, wi) / pdf, pdf, delta: false, eta: 1.0 });
         }
         self.finish(wo, wi)
     }

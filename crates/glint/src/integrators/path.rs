@@ -5,17 +5,26 @@
 
 use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
+
+/// The longest path, in segments, even when `max_depth` is unbounded: a hard ceiling so that
+/// a path trapped between mirrors with a Russian roulette probability of 1 still ends. Light
+/// carried by longer paths is lost (a bias below throughput^4096).
+pub const MAX_PATH_DEPTH: u32 = 4096;
 use crate::math::{Ray, Rgb};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::world::World;
 
 pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
-    let max_depth = s.max_depth.unwrap_or(u32::MAX);
+    let max_depth = s.max_depth.unwrap_or(MAX_PATH_DEPTH).min(MAX_PATH_DEPTH);
     if max_depth == 0 {
         return Rgb::BLACK;
     }
     let mut l = Rgb::BLACK;
     let mut throughput = Rgb::WHITE;
+    // The product of eta^2 over the refractions so far: it undoes the 1/eta^2 radiance
+    // scaling in `throughput` for Russian roulette, as pbrt and Mitsuba do, so that paths
+    // inside glass are not killed for a scale factor that leaving the glass undoes.
+    let mut eta_scale = 1.0f32;
     let mut ray = *camera_ray;
     // Density of the BSDF sample that produced `ray` (solid angle) and whether it was delta;
     // the camera ray behaves like a delta sample (nothing else could have produced it).
@@ -103,6 +112,7 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
             break;
         }
         throughput *= bs.weight;
+        eta_scale *= bs.eta * bs.eta;
         let wi_world = frame.to_world(bs.wi);
         prev_pdf = bs.pdf;
         prev_delta = bs.delta;
@@ -112,7 +122,7 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
         if depth >= s.rr_depth {
             let q = match s.rr_probability {
                 Some(p) => p,
-                None => throughput.max_component().min(0.95),
+                None => (throughput.max_component() * eta_scale).min(0.95),
             };
             if q <= 0.0 || rng.next_f32() >= q {
                 break;
