@@ -438,6 +438,13 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         }
     })?;
     let ctx = Ctx { path, spans: Spans::scan(text), dir: path.parent().unwrap_or(Path::new(".")).to_path_buf() };
+    if let Some((key_path, pos)) = ctx.spans.first_duplicate() {
+        let key = key_path.rsplit('/').next().unwrap_or(key_path);
+        return Err(Error::at(
+            &SourceLoc::new(path, pos.line, pos.col),
+            format!("'{key}' is given twice in the same object ({key_path})"),
+        ));
+    }
 
     let cam = &file.camera;
     let to_world =

@@ -15,6 +15,8 @@ pub struct Position {
 #[derive(Default)]
 pub struct Spans {
     at: HashMap<String, Position>,
+    /// Keys that appear twice in one object (serde_json keeps the last one silently).
+    duplicates: Vec<(String, Position)>,
 }
 
 impl Spans {
@@ -26,6 +28,11 @@ impl Spans {
         // already refused anything nested deeper than 128).
         let _ = s.value(&mut path, 0);
         s.spans
+    }
+
+    /// The first key given twice in one object, with the place of its second value.
+    pub fn first_duplicate(&self) -> Option<(&str, Position)> {
+        self.duplicates.first().map(|(p, pos)| (p.as_str(), *pos))
     }
 
     /// The start of the value at `path`, or the nearest enclosing value that was recorded.
@@ -82,7 +89,10 @@ impl Scanner<'_> {
         if depth > MAX_DEPTH {
             return None;
         }
-        self.spans.at.insert(path.clone(), self.here());
+        let here = self.here();
+        if self.spans.at.insert(path.clone(), here).is_some() {
+            self.spans.duplicates.push((path.clone(), here));
+        }
         match self.peek()? {
             b'{' => {
                 self.bump();
@@ -205,6 +215,13 @@ mod tests {
         let s = Spans::scan(text);
         assert_eq!(s.get("s/0/material").line, 2);
         assert_eq!(s.get("s/1/material").line, 3);
+    }
+
+    #[test]
+    fn a_key_given_twice_is_found() {
+        let s = Spans::scan("{\"m\": {\"w\": 1,\n \"w\": 2}}");
+        assert_eq!(s.first_duplicate(), Some(("m/w", Position { line: 2, col: 7 })));
+        assert_eq!(Spans::scan("{\"a\": [1, 2], \"b\": {\"a\": 1}}").first_duplicate(), None);
     }
 
     #[test]
