@@ -53,7 +53,7 @@ def test_mitsuba_defines(tmp_path):
 
 def test_scene_error_carries_file_and_line(tmp_path):
     path = tmp_path / "bad.json"
-    path.write_text('{"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},\n  "film": {"width": 8, "height": 8},\n  "shapes": [ {"type": "teapot"} ]\n}\n')
+    path.write_text('{"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 40},\n  "film": {"width": 8, "height": 8},\n  "shapes": [ {"type": "teapot"} ]\n}\n')
     with pytest.raises(glint.SceneError) as e:
         glint.load_file(path)
     err = e.value

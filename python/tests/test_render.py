@@ -95,8 +95,9 @@ def test_png_round_trip_is_8_bit_srgb(tmp_path):
     img = np.random.default_rng(2).random((6, 4, 3), dtype=np.float32)
     glint.write_image(tmp_path / "x.png", img)
     back = glint.read_image(tmp_path / "x.png")
-    # 8-bit sRGB: half a step of 1/255 in sRGB is at most about 0.002 in linear below 1.
-    np.testing.assert_allclose(back, img, atol=3e-3)
+    # 8-bit sRGB: rounding moves a value by half a step (0.5/255) in sRGB, which is at
+    # most 2.4 times that in linear below 1 (the curve's steepest slope there).
+    np.testing.assert_allclose(back, img, atol=2.4 * 0.5 / 255 + 1e-6)
 
 
 def test_exr_with_layers(tmp_path):

@@ -28,8 +28,9 @@ pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) 
     })
 }
 
-/// A mesh given as arrays, for shape `index` of a JSON scene.
+/// A mesh given as arrays (a dict), for shape `index` of a JSON scene.
 #[derive(FromPyObject)]
+#[pyo3(from_item_all)]
 pub struct MeshArrays<'py> {
     index: usize,
     positions: PyReadonlyArray2<'py, f32>,
