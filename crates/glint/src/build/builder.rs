@@ -83,6 +83,15 @@ fn material_from_mtl(m: &obj::MtlMaterial) -> Material {
     Material::new(format!("mtl:{}", m.name), kind, true)
 }
 
+/// A private copy of `mesh` with `to_world` baked into its vertices (and its own BVH).
+pub(crate) fn bake(mesh: &TriangleMesh, to_world: &Transform, split: BvhSplit) -> Result<TriangleMesh, String> {
+    let positions = mesh.positions.iter().map(|&p| to_world.point(p)).collect();
+    let normals = mesh.normals.as_ref().map(|ns| ns.iter().map(|&n| to_world.normal(n).normalize()).collect());
+    // Indices are kept: as in Mitsuba, a mirroring transform reverses the winding and so
+    // flips the face normal.
+    TriangleMesh::new(positions, normals, mesh.uvs.clone(), mesh.indices.clone(), split)
+}
+
 pub struct WorldBuilder {
     pub split: BvhSplit,
     meshes: Vec<Arc<TriangleMesh>>,
@@ -178,11 +187,7 @@ impl WorldBuilder {
             (mesh.clone(), if to_world.is_identity() { None } else { Some(*to_world) })
         } else {
             let start = Instant::now();
-            let positions = mesh.positions.iter().map(|&p| to_world.point(p)).collect();
-            let normals = mesh.normals.as_ref().map(|ns| ns.iter().map(|&n| to_world.normal(n).normalize()).collect());
-            // Indices are kept: as in Mitsuba, a mirroring transform reverses the winding and
-            // so flips the face normal.
-            let m = TriangleMesh::new(positions, normals, mesh.uvs.clone(), mesh.indices.clone(), self.split)?;
+            let m = bake(mesh, to_world, self.split)?;
             self.build_seconds += start.elapsed().as_secs_f64();
             (Arc::new(m), None)
         };
@@ -290,6 +295,10 @@ impl WorldBuilder {
         self.lights.push(PendingLight::EnvMap { image, scale, to_world });
     }
 
+    pub fn light_count(&self) -> usize {
+        self.lights.len()
+    }
+
     pub fn instance_count(&self) -> usize {
         self.instances.len()
     }
@@ -302,25 +311,8 @@ impl WorldBuilder {
     pub fn finish(self, camera: Camera, selection: LightSelection) -> Result<World, String> {
         let start = Instant::now();
         let bounds = self.instances.iter().fold(Aabb::EMPTY, |a, i| a.union(i.bounds));
-        let radius = scene_radius(&bounds);
-        let mut lights = Vec::new();
-        let mut environment_lights = Vec::new();
-        for l in self.lights {
-            let light = match l {
-                PendingLight::Ready(l) => l,
-                PendingLight::Directional { direction, irradiance } => {
-                    Light::Directional { direction, irradiance, scene_radius: radius }
-                }
-                PendingLight::Constant { radiance } => Light::Constant { radiance, scene_radius: radius },
-                PendingLight::EnvMap { image, scale, to_world } => {
-                    Light::EnvMap(Arc::new(EnvMap::new(image, scale, to_world, radius)?))
-                }
-            };
-            if matches!(light, Light::Constant { .. } | Light::EnvMap(_)) {
-                environment_lights.push(lights.len() as u32);
-            }
-            lights.push(light);
-        }
+        let lights = finish_lights(self.lights, scene_radius(&bounds))?;
+        let environment_lights = environment_lights(&lights);
         let mut scene = World {
             meshes: self.meshes,
             spheres: self.spheres,
@@ -340,4 +332,34 @@ impl WorldBuilder {
         scene.bvh_build_seconds = self.build_seconds + start.elapsed().as_secs_f64();
         Ok(scene)
     }
+
+    /// The lights placed so far, finished for a scene of the given bounds (a session that
+    /// edits lights in a built world makes them this way).
+    pub(crate) fn into_lights(self, bounds: &Aabb) -> Result<Vec<Light>, String> {
+        finish_lights(self.lights, scene_radius(bounds))
+    }
+}
+
+fn finish_lights(pending: Vec<PendingLight>, radius: f32) -> Result<Vec<Light>, String> {
+    let mut lights = Vec::with_capacity(pending.len());
+    for l in pending {
+        lights.push(match l {
+            PendingLight::Ready(l) => l,
+            PendingLight::Directional { direction, irradiance } => {
+                Light::Directional { direction, irradiance, scene_radius: radius }
+            }
+            PendingLight::Constant { radiance } => Light::Constant { radiance, scene_radius: radius },
+            PendingLight::EnvMap { image, scale, to_world } => {
+                Light::EnvMap(Arc::new(EnvMap::new(image, scale, to_world, radius)?))
+            }
+        });
+    }
+    Ok(lights)
+}
+
+/// Indices of the lights an escaping ray sees.
+pub(crate) fn environment_lights(lights: &[Light]) -> Vec<u32> {
+    (0..lights.len() as u32)
+        .filter(|&i| matches!(lights[i as usize], Light::Constant { .. } | Light::EnvMap(_)))
+        .collect()
 }

@@ -5,24 +5,25 @@
 //! source location.
 
 mod builder;
+mod cache;
 mod validate;
 
 pub use builder::{LoadedGroup, WorldBuilder};
+pub(crate) use cache::patch_appearance;
+pub use cache::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
 
 use crate::accel::BvhSplit;
 use crate::bsdf::Microfacet;
 use crate::camera::Camera;
 use crate::describe::{
-    CameraDesc, Geometry, LightKind, MaterialModel, MaterialRef, Matrix4, Roughness, SceneDesc, ShapeDesc, TextureDesc,
+    CameraDesc, Geometry, LightKind, MaterialModel, MaterialRef, Matrix4, Roughness, SceneDesc, TextureDesc,
 };
 use crate::error::{Error, SourceLoc};
-use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, TriangleMesh};
 use crate::lights::Light;
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
-use crate::math::{Frame, Mat4, Transform, Vec3};
+use crate::math::{Aabb, Frame, Mat4, Transform, Vec3};
 use crate::world::World;
-use rayon::prelude::*;
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -34,57 +35,12 @@ pub struct BuildOptions {
 
 /// Builds the world a description describes.
 pub fn build(desc: &SceneDesc, opts: &BuildOptions) -> Result<World, Error> {
-    validate::check(desc)?;
-    let mut b = WorldBuilder::new(opts.bvh_split);
-    let mut textures = TextureCache::default();
+    Ok(build_cached(desc, opts, &mut MeshCache::default(), &BTreeSet::new())?.world)
+}
 
-    let mut material_ids = Vec::with_capacity(desc.materials.len());
-    for m in &desc.materials {
-        let kind = material_kind(&m.model, &mut textures).map_err(|e| e.or_at(&m.loc))?;
-        material_ids.push(b.add_material(Material::new(m.name.clone(), kind, m.two_sided)));
-    }
-
-    // Every mesh file, loaded and its BVH built in parallel, before any shape is placed.
-    let mut files: Vec<(PathBuf, bool)> = Vec::new();
-    for m in &desc.meshes {
-        files.push((m.file.clone(), m.face_normals));
-    }
-    for s in &desc.shapes {
-        if let Geometry::MeshFile { file, face_normals } = &s.geometry {
-            files.push((file.clone(), *face_normals));
-        }
-    }
-    files.sort();
-    files.dedup();
-    let start = std::time::Instant::now();
-    let loaded: Vec<Result<Vec<LoadedGroup>, String>> = files
-        .par_iter()
-        .map(|(file, face_normals)| builder::read_mesh_file(file, *face_normals, opts.bvh_split))
-        .collect();
-    b.build_seconds += start.elapsed().as_secs_f64();
-    let mut groups_of: HashMap<(PathBuf, bool), Vec<LoadedGroup>> = HashMap::new();
-    for (key, result) in files.into_iter().zip(loaded) {
-        match result {
-            Ok(g) => {
-                groups_of.insert(key, g);
-            }
-            Err(e) => {
-                let loc = mesh_loc(desc, &key.0);
-                return Err(Error::at(&loc, e));
-            }
-        }
-    }
-    for s in &desc.shapes {
-        add_shape(&mut b, desc, s, &material_ids, &groups_of).map_err(|e| e.or_at(&s.loc))?;
-    }
-
-    for l in &desc.lights {
-        add_light(&mut b, &l.light, &mut textures).map_err(|e| e.or_at(&l.loc))?;
-    }
-
-    let camera = camera(desc, &b).map_err(|e| e.or_at(&desc.camera.loc))?;
-    let origin = desc.source.as_deref().map(SourceLoc::file).unwrap_or_default();
-    b.finish(camera, desc.light_selection).map_err(|e| Error::at(&origin, e))
+/// Checks every number of a description, as a build does first.
+pub(crate) fn validate_description(desc: &SceneDesc) -> Result<(), Error> {
+    validate::check(desc)
 }
 
 /// Where a mesh file is named, for errors found while reading it.
@@ -170,47 +126,6 @@ fn material_id(b: &mut WorldBuilder, r: MaterialRef, ids: &[u32]) -> Result<u32,
     })
 }
 
-fn add_shape(
-    b: &mut WorldBuilder,
-    desc: &SceneDesc,
-    s: &ShapeDesc,
-    material_ids: &[u32],
-    groups_of: &HashMap<(PathBuf, bool), Vec<LoadedGroup>>,
-) -> Result<(), Error> {
-    let to_world = transform_of(&s.to_world)?;
-    let material = material_id(b, s.material, material_ids)?;
-    let (groups, instanced) = match &s.geometry {
-        Geometry::MeshFile { file, face_normals } => (groups_of[&(file.clone(), *face_normals)].clone(), false),
-        Geometry::Instance { mesh } => {
-            let m = desc.meshes.get(*mesh).ok_or_else(|| {
-                Error::new(format!("mesh index {mesh} is out of range ({} meshes)", desc.meshes.len()))
-            })?;
-            (groups_of[&(m.file.clone(), m.face_normals)].clone(), true)
-        }
-        Geometry::Mesh(data) => {
-            let mesh = TriangleMesh::new(
-                data.positions.clone(),
-                data.normals.clone(),
-                data.uvs.clone(),
-                data.indices.clone(),
-                b.split,
-            )?;
-            (vec![LoadedGroup::primitive(mesh)], false)
-        }
-        Geometry::Sphere { center, radius } => {
-            return Ok(b.add_sphere(*center, *radius, &to_world, material, s.emission, s.flip_normals)?);
-        }
-        Geometry::Rectangle => (vec![LoadedGroup::primitive(rectangle_mesh(b.split))], false),
-        Geometry::Cube => (vec![LoadedGroup::primitive(cube_mesh(b.split))], false),
-        Geometry::Disk => (vec![LoadedGroup::primitive(disk_mesh(b.split))], false),
-    };
-    for g in &groups {
-        let m = if s.use_mtl && !g.material.is_empty() { b.mtl_material(g).unwrap_or(material) } else { material };
-        b.add_mesh_instance(&g.mesh, &to_world, instanced, m, s.emission, s.flip_normals)?;
-    }
-    Ok(())
-}
-
 fn add_light(b: &mut WorldBuilder, l: &LightKind, textures: &mut TextureCache) -> Result<(), Error> {
     match l {
         LightKind::Point { position, intensity } => {
@@ -235,11 +150,11 @@ fn add_light(b: &mut WorldBuilder, l: &LightKind, textures: &mut TextureCache) -
     Ok(())
 }
 
-fn camera(desc: &SceneDesc, b: &WorldBuilder) -> Result<Camera, Error> {
+fn camera(desc: &SceneDesc, bounds: &Aabb) -> Result<Camera, Error> {
     let c: &CameraDesc = &desc.camera;
     let to_world = match &c.to_world {
         Some(m) => transform_of(m)?,
-        None => frame_bounds(b)?,
+        None => frame_bounds(bounds)?,
     };
     let mut camera = Camera::new(to_world, desc.film.width, desc.film.height, c.fov_degrees, c.fov_axis);
     camera.lens_radius = c.lens_radius;
@@ -250,8 +165,7 @@ fn camera(desc: &SceneDesc, b: &WorldBuilder) -> Result<Camera, Error> {
 }
 
 /// A camera in front of (+z) the scene's bounds, looking at their centre (mesh previews).
-fn frame_bounds(b: &WorldBuilder) -> Result<Transform, Error> {
-    let bounds = b.bounds();
+fn frame_bounds(bounds: &Aabb) -> Result<Transform, Error> {
     let centre = bounds.center();
     let radius = bounds.extent().length() * 0.5;
     let eye = centre + Vec3 { x: 0.0, y: 0.0, z: radius * 2.8 };

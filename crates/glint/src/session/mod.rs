@@ -31,11 +31,13 @@
 //! # }
 //! ```
 
+mod edit;
 mod job;
 
+pub use edit::{Param, ParamValue};
 pub use job::{RenderJob, JOB_VERSION};
 
-use crate::build::{build, BuildOptions};
+use crate::build::{build_cached, BuildOptions, MeshCache, WorldLayout};
 use crate::describe::SceneDesc;
 use crate::error::{Error, SourceLoc};
 use crate::formats::{read, ReadOptions};
@@ -45,6 +47,7 @@ use crate::render::{
     RenderSettings, RenderStats,
 };
 use crate::world::World;
+use std::collections::BTreeSet;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -98,6 +101,13 @@ pub struct Session {
     desc: SceneDesc,
     build_options: BuildOptions,
     world: Option<Arc<World>>,
+    /// Meshes (with their BVHs) of earlier builds, so a build after an edit builds only
+    /// what changed.
+    cache: MeshCache,
+    /// Where the description's entities are in the built world (for in-place edits).
+    layout: Option<WorldLayout>,
+    /// Shapes whose transform was edited: traced through it rather than baked.
+    instanced: BTreeSet<usize>,
     /// Adaptive settings of the film being rendered (stored in its checkpoints).
     adaptive: Option<Adaptive>,
 }
@@ -109,14 +119,23 @@ impl Session {
     }
 
     pub fn from_description(desc: SceneDesc) -> Session {
-        Session { desc, build_options: BuildOptions::default(), world: None, adaptive: None }
+        Session {
+            desc,
+            build_options: BuildOptions::default(),
+            world: None,
+            cache: MeshCache::default(),
+            layout: None,
+            instanced: BTreeSet::new(),
+            adaptive: None,
+        }
     }
 
     pub fn description(&self) -> &SceneDesc {
         &self.desc
     }
 
-    /// The description, to edit; the world is built again on next use.
+    /// The description, to edit; the world is built again on next use (from the cached
+    /// meshes where they are unchanged).
     pub fn edit(&mut self) -> &mut SceneDesc {
         self.world = None;
         &mut self.desc
@@ -138,8 +157,10 @@ impl Session {
         if let Some(w) = &self.world {
             return Ok(w.clone());
         }
-        let w = Arc::new(build(&self.desc, &self.build_options)?);
+        let built = build_cached(&self.desc, &self.build_options, &mut self.cache, &self.instanced)?;
+        let w = Arc::new(built.world);
         self.world = Some(w.clone());
+        self.layout = Some(built.layout);
         Ok(w)
     }
 

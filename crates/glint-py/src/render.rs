@@ -1,0 +1,283 @@
+//! `Session`: renders a scene pass by pass into a film, with the GIL released, Ctrl-C,
+//! a time limit, a progress callback and a thread count.
+
+use crate::convert::{guard, panic_message, scene_error};
+use crate::images::image_array;
+use crate::scene::Scene;
+use glint::render::{Aov, Film, RenderStats, Silent};
+use glint::session::{FilmOptions, RenderControl, RenderReport};
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray3};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+/// How often the waiting thread takes the GIL to look for Ctrl-C (and maybe call the
+/// progress callback): short enough that Ctrl-C feels immediate.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+/// The progress callback is called no more often than this.
+const PROGRESS_INTERVAL: Duration = Duration::from_millis(250);
+
+/// Renders a scene pass by pass into a film of `spp` samples per pixel.
+#[pyclass(module = "glint._glint")]
+pub struct Session {
+    scene: Py<Scene>,
+    film: Film,
+    seed: u64,
+    threads: Option<usize>,
+    stats: RenderStats,
+}
+
+/// Set when the render thread is done; the waiting thread sleeps on it.
+#[derive(Default)]
+struct DoneSignal {
+    done: Mutex<bool>,
+    cv: Condvar,
+}
+
+impl DoneSignal {
+    fn set(&self) {
+        *self.done.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        self.cv.notify_all();
+    }
+    /// Waits up to `t`; true once done.
+    fn wait(&self, t: Duration) -> bool {
+        let g = self.done.lock().unwrap_or_else(|e| e.into_inner());
+        let (g, _) = self.cv.wait_timeout_while(g, t, |d| !*d).unwrap_or_else(|e| e.into_inner());
+        *g
+    }
+}
+
+/// Samples per pixel in the film's leading complete passes.
+fn samples_done(film: &Film) -> u32 {
+    match film.passes_done() {
+        0 => 0,
+        n => film.pass_samples(n - 1).end,
+    }
+}
+
+fn add(total: &mut RenderStats, s: &RenderStats) {
+    total.seconds += s.seconds;
+    total.camera_rays += s.camera_rays;
+    total.rays += s.rays;
+    total.shadow_rays += s.shadow_rays;
+    total.discarded_samples += s.discarded_samples;
+}
+
+#[pymethods]
+impl Session {
+    #[new]
+    #[pyo3(signature = (scene, spp=None, seed=0, aovs=Vec::new(), threads=None))]
+    fn new(
+        py: Python<'_>,
+        scene: Py<Scene>,
+        spp: Option<u32>,
+        seed: u64,
+        aovs: Vec<String>,
+        threads: Option<usize>,
+    ) -> PyResult<Session> {
+        guard(|| {
+            let aovs = aovs
+                .iter()
+                .map(|a| a.parse::<Aov>().map_err(|e| PyValueError::new_err(format!("aovs: {e}"))))
+                .collect::<PyResult<Vec<_>>>()?;
+            if threads == Some(0) {
+                return Err(PyValueError::new_err("threads: must be at least 1"));
+            }
+            let mut s = scene.borrow_mut(py);
+            s.session.set_sampling(spp, Some(seed)).map_err(|e| scene_error(py, e))?;
+            let film = s
+                .session
+                .new_film(&FilmOptions { pass_spp: None, region: None, aovs })
+                .map_err(|e| scene_error(py, e))?;
+            drop(s);
+            Ok(Session { scene, film, seed, threads, stats: RenderStats::default() })
+        })
+    }
+
+    /// Renders `passes` more passes (all that are left by default), stopping early at
+    /// `time_limit` seconds. `progress(done_spp, total_spp)` is called from this thread at
+    /// most four times a second and once at the end. Returns the passes rendered. Ctrl-C
+    /// raises KeyboardInterrupt within a pass's time, keeping the passes done.
+    #[pyo3(signature = (passes=None, time_limit=None, progress=None))]
+    fn render_passes(
+        &mut self,
+        py: Python<'_>,
+        passes: Option<u32>,
+        time_limit: Option<f64>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<u32> {
+        guard(|| self.render_inner(py, passes, time_limit, progress))
+    }
+
+    /// The image so far: float32 (height, width, 3), linear RGB.
+    fn image<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
+        image_array(py, &self.film.image())
+    }
+
+    /// The AOV layers so far: name -> float32 (height, width, channels).
+    fn aovs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for a in self.film.aovs() {
+            if let Some(img) = self.film.aov(*a) {
+                let c = img.channels.len();
+                let arr =
+                    Array3::from_shape_vec((img.height, img.width, c), img.data).expect("a layer fills the image");
+                d.set_item(img.name, arr.into_pyarray(py))?;
+            }
+        }
+        Ok(d)
+    }
+
+    /// Channel names of each AOV layer, as an EXR file names them.
+    fn aov_channels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for a in self.film.aovs() {
+            d.set_item(a.name(), a.channels())?;
+        }
+        Ok(d)
+    }
+
+    /// Samples per pixel rendered so far.
+    #[getter]
+    fn spp(&self) -> u32 {
+        samples_done(&self.film)
+    }
+
+    /// Samples per pixel of the finished film.
+    #[getter]
+    fn target_spp(&self) -> u32 {
+        self.film.spp()
+    }
+
+    #[getter]
+    fn passes_done(&self) -> u32 {
+        self.film.passes_done()
+    }
+
+    #[getter]
+    fn pass_count(&self) -> u32 {
+        self.film.pass_count()
+    }
+
+    /// The scene rendered.
+    #[getter]
+    fn scene(&self, py: Python<'_>) -> Py<Scene> {
+        self.scene.clone_ref(py)
+    }
+
+    /// Rays and seconds of this session's renders so far, and the scene's build counters.
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.stats;
+        let d = self.scene.borrow(py).build_counters(py)?;
+        d.set_item("seconds", s.seconds)?;
+        d.set_item("camera_rays", s.camera_rays)?;
+        d.set_item("rays", s.rays)?;
+        d.set_item("shadow_rays", s.shadow_rays)?;
+        d.set_item("discarded_samples", s.discarded_samples)?;
+        Ok(d)
+    }
+}
+
+impl Session {
+    fn render_inner(
+        &mut self,
+        py: Python<'_>,
+        passes: Option<u32>,
+        time_limit: Option<f64>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<u32> {
+        let time_limit = match time_limit {
+            Some(t) if !(t >= 0.0 && t.is_finite()) => {
+                return Err(PyValueError::new_err(format!("time_limit: {t} is not a number of seconds")))
+            }
+            t => t.map(Duration::from_secs_f64),
+        };
+        let first = self.film.passes_done();
+        let end = match passes {
+            Some(n) => first.saturating_add(n).min(self.film.pass_count()),
+            None => self.film.pass_count(),
+        };
+        let pool = match self.threads {
+            Some(n) => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(|e| PyRuntimeError::new_err(format!("threads: {e}")))?,
+            ),
+            None => None,
+        };
+        let mut scene = self.scene.try_borrow_mut(py)?;
+        // Another session of this scene may have set other sampling.
+        scene.session.set_sampling(Some(self.film.spp()), Some(self.seed)).map_err(|e| scene_error(py, e))?;
+        let session = &mut scene.session;
+        let film = &mut self.film;
+        let total = film.spp();
+        let cancel = AtomicBool::new(false);
+        let done_spp = AtomicU32::new(samples_done(film));
+        let signal = DoneSignal::default();
+
+        let mut interrupt: Option<PyErr> = None;
+        let outcome = std::thread::scope(|s| {
+            let worker = s.spawn(|| {
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    let control =
+                        RenderControl { passes: Some(first..end), time_limit, ..RenderControl::new(&cancel, &Silent) };
+                    let mut work = || {
+                        session.render(film, &control, &mut |f: &Film| {
+                            done_spp.store(samples_done(f), Ordering::Relaxed);
+                            Ok(())
+                        })
+                    };
+                    match &pool {
+                        Some(p) => p.install(work),
+                        None => work(),
+                    }
+                }));
+                signal.set();
+                r
+            });
+            // This thread waits without the GIL, taking it briefly to run Python's signal
+            // handlers (Ctrl-C) and the progress callback.
+            let mut last_progress = Instant::now();
+            while !py.detach(|| signal.wait(SIGNAL_POLL)) {
+                if let Err(e) = py.check_signals() {
+                    cancel.store(true, Ordering::Relaxed);
+                    interrupt = Some(e);
+                    break;
+                }
+                if let Some(cb) = &progress {
+                    if last_progress.elapsed() >= PROGRESS_INTERVAL {
+                        last_progress = Instant::now();
+                        if let Err(e) = cb.call1(py, (done_spp.load(Ordering::Relaxed), total)) {
+                            cancel.store(true, Ordering::Relaxed);
+                            interrupt = Some(e);
+                            break;
+                        }
+                    }
+                }
+            }
+            py.detach(|| worker.join())
+        });
+        drop(scene);
+        let report: RenderReport = match outcome {
+            Ok(Ok(Ok(r))) => r,
+            Ok(Ok(Err(e))) => return Err(scene_error(py, e)),
+            Ok(Err(p)) | Err(p) => {
+                return Err(PyRuntimeError::new_err(format!("glint: internal error: {}", panic_message(p))))
+            }
+        };
+        add(&mut self.stats, &report.stats);
+        if let Some(e) = interrupt {
+            return Err(e);
+        }
+        if let Some(cb) = &progress {
+            cb.call1(py, (samples_done(&self.film), total))?;
+        }
+        Ok(report.passes.end - report.passes.start)
+    }
+}

@@ -1,0 +1,196 @@
+//! `Scene`: a loaded scene, its built world and mesh cache (a library session).
+
+use crate::convert::{guard, scene_error};
+use glint::describe::{Geometry, MeshData};
+use glint::formats::{Define, ReadOptions};
+use glint::math::{Rgb, Vec3};
+use glint::session::{Param, ParamValue, Session};
+use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::PathBuf;
+
+/// A loaded scene: its description and, once rendered, its built world. Made by
+/// `glint.load_file` or `glint.load_dict`; edited through `glint.traverse`.
+#[pyclass(module = "glint._glint")]
+pub struct Scene {
+    pub(crate) session: Session,
+}
+
+/// Reads a scene file; `defines` are (name, value) Mitsuba `<default>` overrides.
+#[pyfunction]
+pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) -> PyResult<Scene> {
+    guard(|| {
+        let defines = defines.into_iter().map(|(name, value)| Define { name, value }).collect();
+        let session = py.detach(|| Session::open(&path, &ReadOptions { defines })).map_err(|e| scene_error(py, e))?;
+        Ok(Scene { session })
+    })
+}
+
+/// A mesh given as arrays (a dict), for shape `index` of a JSON scene.
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct MeshArrays<'py> {
+    index: usize,
+    positions: PyReadonlyArray2<'py, f32>,
+    indices: PyReadonlyArray2<'py, u32>,
+    normals: Option<PyReadonlyArray2<'py, f32>>,
+    uvs: Option<PyReadonlyArray2<'py, f32>>,
+}
+
+fn vec3s(name: &str, a: &PyReadonlyArray2<'_, f32>) -> PyResult<Vec<Vec3>> {
+    if a.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("{name}: expected shape (N, 3), got {:?}", a.shape())));
+    }
+    Ok(a.as_array().outer_iter().map(|r| Vec3 { x: r[0], y: r[1], z: r[2] }).collect())
+}
+
+impl MeshArrays<'_> {
+    fn data(&self) -> PyResult<MeshData> {
+        let i = &self.indices;
+        if i.shape()[1] != 3 {
+            return Err(PyValueError::new_err(format!("indices: expected shape (M, 3), got {:?}", i.shape())));
+        }
+        let uvs = match &self.uvs {
+            Some(u) if u.shape()[1] != 2 => {
+                return Err(PyValueError::new_err(format!("uvs: expected shape (N, 2), got {:?}", u.shape())))
+            }
+            Some(u) => Some(u.as_array().outer_iter().map(|r| [r[0], r[1]]).collect()),
+            None => None,
+        };
+        Ok(MeshData {
+            positions: vec3s("positions", &self.positions)?,
+            indices: i.as_array().outer_iter().map(|r| [r[0], r[1], r[2]]).collect(),
+            normals: self.normals.as_ref().map(|n| vec3s("normals", n)).transpose()?,
+            uvs,
+        })
+    }
+}
+
+/// Reads a scene from JSON text as if from `path` (relative files resolve beside it); each
+/// of `meshes` replaces the geometry of its shape (a placeholder in the text).
+#[pyfunction]
+pub fn load_json(py: Python<'_>, text: &str, path: PathBuf, meshes: Vec<MeshArrays<'_>>) -> PyResult<Scene> {
+    guard(|| {
+        let mut desc = glint::formats::json::read(&path, text).map_err(|e| scene_error(py, e))?;
+        for m in &meshes {
+            let n = desc.shapes.len();
+            let shape = desc
+                .shapes
+                .get_mut(m.index)
+                .ok_or_else(|| PyValueError::new_err(format!("mesh for shape {} of {n}", m.index)))?;
+            shape.geometry = Geometry::Mesh(m.data()?);
+        }
+        Ok(Scene { session: Session::from_description(desc) })
+    })
+}
+
+fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        ParamValue::Float(x) => (*x as f64).into_pyobject(py)?.into_any(),
+        ParamValue::Color(c) => ("color", vec![c.r, c.g, c.b]).into_pyobject(py)?.into_any(),
+        ParamValue::Matrix(m) => {
+            ("matrix", m.iter().map(|r| r.to_vec()).collect::<Vec<_>>()).into_pyobject(py)?.into_any()
+        }
+    })
+}
+
+#[pymethods]
+impl Scene {
+    /// Image width in pixels.
+    #[getter]
+    fn width(&self) -> u32 {
+        self.session.description().film.width
+    }
+
+    /// Image height in pixels.
+    #[getter]
+    fn height(&self) -> u32 {
+        self.session.description().film.height
+    }
+
+    /// The samples per pixel the scene asks for.
+    #[getter]
+    fn spp(&self) -> u32 {
+        self.session.description().sampler.spp
+    }
+
+    /// What the reader accepted but cannot honour exactly.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.session.description().warnings.clone()
+    }
+
+    /// The scene description as JSON text (glint's plain-data `SceneDesc`).
+    fn description_json(&self) -> String {
+        serde_json::to_string(self.session.description()).unwrap_or_default()
+    }
+
+    /// Editable parameters as (name, value) pairs; a colour is ("color", [r, g, b]), a
+    /// matrix ("matrix", rows), a number a float.
+    fn _params<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let items = self
+            .session
+            .params()
+            .iter()
+            .map(|p| Ok((p.name.clone(), value_to_py(py, &p.value)?)))
+            .collect::<PyResult<Vec<_>>>()?;
+        PyList::new(py, items)
+    }
+
+    /// Sets parameters given as (name, kind, values) with kind "float" (one value),
+    /// "color" (3) or "matrix" (16, row-major).
+    fn _set_params(&mut self, py: Python<'_>, edits: Vec<(String, String, Vec<f64>)>) -> PyResult<()> {
+        guard(|| {
+            let mut params = Vec::with_capacity(edits.len());
+            for (name, kind, v) in edits {
+                let value = match (kind.as_str(), v.len()) {
+                    ("float", 1) => ParamValue::Float(v[0] as f32),
+                    ("color", 3) => ParamValue::Color(Rgb { r: v[0] as f32, g: v[1] as f32, b: v[2] as f32 }),
+                    ("matrix", 16) => {
+                        let mut m = [[0.0; 4]; 4];
+                        for (i, x) in v.iter().enumerate() {
+                            m[i / 4][i % 4] = *x;
+                        }
+                        ParamValue::Matrix(m)
+                    }
+                    _ => return Err(PyTypeError::new_err(format!("{name}: {} values for a {kind}", v.len()))),
+                };
+                params.push(Param { name, value });
+            }
+            self.session.set_params(&params).map_err(|e| scene_error(py, e))
+        })
+    }
+
+    /// How many BVHs the builds of this scene made so far: `mesh_bvh_builds` (bottom
+    /// level) and `top_level_builds`.
+    pub(crate) fn build_counters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = self.session.build_counters();
+        let d = PyDict::new(py);
+        d.set_item("mesh_bvh_builds", c.mesh_bvh_builds)?;
+        d.set_item("top_level_builds", c.top_level_builds)?;
+        Ok(d)
+    }
+
+    /// Builds the world now (rendering builds it when needed).
+    fn build(&mut self, py: Python<'_>) -> PyResult<()> {
+        guard(|| {
+            let s = &mut self.session;
+            py.detach(|| s.world().map(|_| ())).map_err(|e| scene_error(py, e))
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        let d = self.session.description();
+        let source = d.source.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "<dict>".into());
+        format!(
+            "<glint.Scene {source}: {}x{}, {} shapes, {} lights, {} spp>",
+            d.film.width,
+            d.film.height,
+            d.shapes.len(),
+            d.lights.len(),
+            d.sampler.spp
+        )
+    }
+}

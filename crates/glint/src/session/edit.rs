@@ -1,0 +1,268 @@
+//! Named parameters of a session's scene, read and changed in place: what the Python API's
+//! `traverse` shows. A parameter edit changes the description and then as little of the
+//! built world as it can: material, emission, light and camera edits are patched into the
+//! world (no BVH is built), and a shape's transform edit rebuilds the world from the cached
+//! meshes, the shape now traced through its transform (only the top-level BVH is built; the
+//! image can differ in the last bits from a fresh load of the edited scene, which bakes the
+//! transform into the vertices).
+//!
+//! Names: `materials.NAME.FIELD` (`reflectance`, `kd`, `diffuse` when the texture is a
+//! constant; `ks`, `exponent`, `eta`, `k`, `specular`, `reflect`, `transmit`, `alpha`),
+//! `lights.I.FIELD` (`intensity`, `irradiance`, `radiance`, `scale`), `shapes.I.emission`,
+//! `shapes.I.to_world`, `camera.fov`, `camera.to_world`.
+
+use super::Session;
+use crate::build::{patch_appearance, BuildCounters};
+use crate::describe::{limits, LightKind, MaterialModel, Matrix4, Roughness, SceneDesc, TextureDesc};
+use crate::error::Error;
+use crate::math::Rgb;
+use std::sync::Arc;
+
+/// A parameter's value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamValue {
+    Float(f32),
+    Color(Rgb),
+    Matrix(Matrix4),
+}
+
+impl ParamValue {
+    fn kind(&self) -> &'static str {
+        match self {
+            ParamValue::Float(_) => "a number",
+            ParamValue::Color(_) => "a colour (3 numbers)",
+            ParamValue::Matrix(_) => "a 4x4 matrix",
+        }
+    }
+}
+
+/// A named parameter and its value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Param {
+    pub name: String,
+    pub value: ParamValue,
+}
+
+/// A mutable place in the description that a parameter names.
+enum Slot<'a> {
+    Float(&'a mut f32),
+    Color(&'a mut Rgb),
+    Matrix(&'a mut Matrix4),
+    /// The camera's transform, which may be unset (the bounds are framed).
+    OptionalMatrix(&'a mut Option<Matrix4>),
+}
+
+impl Slot<'_> {
+    fn get(&self) -> Option<ParamValue> {
+        Some(match self {
+            Slot::Float(v) => ParamValue::Float(**v),
+            Slot::Color(v) => ParamValue::Color(**v),
+            Slot::Matrix(v) => ParamValue::Matrix(**v),
+            Slot::OptionalMatrix(v) => ParamValue::Matrix((**v)?),
+        })
+    }
+
+    /// Stores `value`, returning what was there (`None`: an unset camera transform).
+    fn set(self, name: &str, value: ParamValue) -> Result<Option<ParamValue>, Error> {
+        let old = self.get();
+        match (self, value) {
+            (Slot::Float(v), ParamValue::Float(x)) => *v = x,
+            (Slot::Color(v), ParamValue::Color(x)) => *v = x,
+            (Slot::Matrix(v), ParamValue::Matrix(x)) => *v = x,
+            (Slot::OptionalMatrix(v), ParamValue::Matrix(x)) => *v = Some(x),
+            (slot, value) => {
+                let expected = slot.get().map_or("a 4x4 matrix", |v| v.kind());
+                return Err(Error::new(format!("{name} is {expected}, not {}", value.kind())));
+            }
+        }
+        Ok(old)
+    }
+}
+
+/// What an edit changes in the built world.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Effect {
+    Appearance,
+    Transform(usize),
+}
+
+fn roughness_slots<'a>(r: &'a mut Option<Roughness>, out: &mut Vec<(&'static str, Slot<'a>)>) {
+    if let Some(r) = r {
+        out.push(("alpha", Slot::Float(&mut r.alpha)));
+    }
+}
+
+fn texture_slot<'a>(name: &'static str, t: &'a mut TextureDesc, out: &mut Vec<(&'static str, Slot<'a>)>) {
+    if let TextureDesc::Constant { color } = t {
+        out.push((name, Slot::Color(color)));
+    }
+}
+
+fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
+    let mut out = Vec::new();
+    match m {
+        MaterialModel::Diffuse { reflectance } => texture_slot("reflectance", reflectance, &mut out),
+        MaterialModel::Phong { kd, ks, exponent } => {
+            texture_slot("kd", kd, &mut out);
+            out.push(("ks", Slot::Color(ks)));
+            out.push(("exponent", Slot::Float(exponent)));
+        }
+        MaterialModel::Conductor { eta, k, specular, roughness } => {
+            out.push(("eta", Slot::Color(eta)));
+            out.push(("k", Slot::Color(k)));
+            out.push(("specular", Slot::Color(specular)));
+            roughness_slots(roughness, &mut out);
+        }
+        MaterialModel::Dielectric { eta, reflect, transmit, roughness, .. } => {
+            out.push(("eta", Slot::Float(eta)));
+            out.push(("reflect", Slot::Color(reflect)));
+            out.push(("transmit", Slot::Color(transmit)));
+            roughness_slots(roughness, &mut out);
+        }
+        MaterialModel::Plastic { diffuse, specular, eta, roughness } => {
+            texture_slot("diffuse", diffuse, &mut out);
+            out.push(("specular", Slot::Color(specular)));
+            out.push(("eta", Slot::Float(eta)));
+            roughness_slots(roughness, &mut out);
+        }
+        MaterialModel::Black => {}
+    }
+    out
+}
+
+fn light_slots(l: &mut LightKind) -> Vec<(&'static str, Slot<'_>)> {
+    match l {
+        LightKind::Point { intensity, .. } | LightKind::Spot { intensity, .. } => {
+            vec![("intensity", Slot::Color(intensity))]
+        }
+        LightKind::Directional { irradiance, .. } => vec![("irradiance", Slot::Color(irradiance))],
+        LightKind::Constant { radiance } => vec![("radiance", Slot::Color(radiance))],
+        LightKind::EnvMap { scale, .. } => vec![("scale", Slot::Float(scale))],
+    }
+}
+
+/// Every parameter of the description with its slot and effect, in a fixed order.
+fn slots(desc: &mut SceneDesc) -> Vec<(String, Slot<'_>, Effect)> {
+    let mut out = Vec::new();
+    for m in &mut desc.materials {
+        let name = m.name.clone();
+        for (field, slot) in material_slots(&mut m.model) {
+            out.push((format!("materials.{name}.{field}"), slot, Effect::Appearance));
+        }
+    }
+    for (i, s) in desc.shapes.iter_mut().enumerate() {
+        if let Some(e) = &mut s.emission {
+            out.push((format!("shapes.{i}.emission"), Slot::Color(&mut e.radiance), Effect::Appearance));
+        }
+        out.push((format!("shapes.{i}.to_world"), Slot::Matrix(&mut s.to_world), Effect::Transform(i)));
+    }
+    for (i, l) in desc.lights.iter_mut().enumerate() {
+        for (field, slot) in light_slots(&mut l.light) {
+            out.push((format!("lights.{i}.{field}"), slot, Effect::Appearance));
+        }
+    }
+    out.push(("camera.fov".to_string(), Slot::Float(&mut desc.camera.fov_degrees), Effect::Appearance));
+    out.push(("camera.to_world".to_string(), Slot::OptionalMatrix(&mut desc.camera.to_world), Effect::Appearance));
+    out
+}
+
+/// Sets one parameter, returning its old value and what the edit affects.
+fn set_one(desc: &mut SceneDesc, p: &Param) -> Result<(Option<ParamValue>, Effect), Error> {
+    let (_, slot, effect) = slots(desc)
+        .into_iter()
+        .find(|(name, _, _)| *name == p.name)
+        .ok_or_else(|| Error::new(format!("no parameter called '{}'", p.name)))?;
+    Ok((slot.set(&p.name, p.value)?, effect))
+}
+
+impl Session {
+    /// Every editable parameter and its value (the camera's transform only once it is set).
+    pub fn params(&mut self) -> Vec<Param> {
+        slots(&mut self.desc)
+            .into_iter()
+            .filter_map(|(name, slot, _)| slot.get().map(|value| Param { name, value }))
+            .collect()
+    }
+
+    /// Sets parameters; on an error (an unknown name, a wrong kind of value, a value the
+    /// scene cannot take) nothing is changed. Rebuilds as little as the edits need (see the
+    /// module doc).
+    pub fn set_params(&mut self, params: &[Param]) -> Result<(), Error> {
+        // Old values, to put back on an error; the camera's transform may have been unset.
+        let mut undo = Vec::new();
+        let camera_to_world = self.desc.camera.to_world;
+        let mut transforms = Vec::new();
+        for p in params {
+            match set_one(&mut self.desc, p) {
+                Ok((old, effect)) => {
+                    if let Some(value) = old {
+                        undo.push(Param { name: p.name.clone(), value });
+                    }
+                    if let Effect::Transform(i) = effect {
+                        transforms.push(i);
+                    }
+                }
+                Err(e) => {
+                    self.undo(&undo, camera_to_world);
+                    return Err(e);
+                }
+            }
+        }
+        if let Err(e) = self.apply(&transforms) {
+            self.undo(&undo, camera_to_world);
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    fn undo(&mut self, undo: &[Param], camera_to_world: Option<Matrix4>) {
+        for p in undo.iter().rev() {
+            set_one(&mut self.desc, p).expect("an old value goes back where it was");
+        }
+        self.desc.camera.to_world = camera_to_world;
+    }
+
+    /// Brings the built world (if any) up to date with edited parameters.
+    fn apply(&mut self, transforms: &[usize]) -> Result<(), Error> {
+        if !transforms.is_empty() {
+            crate::build::validate_description(&self.desc)?;
+            self.instanced.extend(transforms.iter().copied());
+            self.world = None;
+            return Ok(());
+        }
+        let (Some(world), Some(layout)) = (&mut self.world, &self.layout) else {
+            return crate::build::validate_description(&self.desc);
+        };
+        // The world is shared while a render holds it; it is then built again, from the
+        // cached meshes.
+        let patched = match Arc::get_mut(world) {
+            Some(w) => patch_appearance(w, &self.desc, layout)?,
+            None => false,
+        };
+        if !patched {
+            crate::build::validate_description(&self.desc)?;
+            self.world = None;
+        }
+        Ok(())
+    }
+
+    /// Sets the samples per pixel and seed; the built world is kept (it does not depend on
+    /// them).
+    pub fn set_sampling(&mut self, spp: Option<u32>, seed: Option<u64>) -> Result<(), Error> {
+        if let Some(spp) = spp {
+            if spp == 0 || spp > limits::MAX_SPP {
+                return Err(Error::new(format!("spp {spp} is out of range (1 to {})", limits::MAX_SPP)));
+            }
+            self.desc.sampler.spp = spp;
+        }
+        if let Some(seed) = seed {
+            self.desc.sampler.seed = seed;
+        }
+        Ok(())
+    }
+
+    /// How many BVHs this session's builds have made so far.
+    pub fn build_counters(&self) -> BuildCounters {
+        self.cache.counters
+    }
+}

@@ -1,0 +1,346 @@
+"""glint: a physically based CPU renderer, from Python.
+
+Load a scene, render it to a numpy array, edit its parameters and render again, denoise::
+
+    import glint
+    scene = glint.load_file("scenes/cornell-box.json")
+    result = glint.render(scene, spp=64)          # result.image: float32 (H, W, 3), linear
+    params = glint.traverse(scene)
+    params["shapes.5.emission"] *= 2              # brighter light; no BVH is rebuilt
+    params.update()
+    brighter = glint.render(scene, spp=64).image
+    glint.write_image("cornell.exr", brighter)
+
+The image of ``glint.render(scene, spp=N, seed=S)`` is bit-identical to that of
+``glint render SCENE -o out.pfm --spp N --seed S``. Rendering releases the GIL, stops on
+Ctrl-C (KeyboardInterrupt) and can be limited to ``threads`` worker threads.
+"""
+
+import json
+import os
+from collections.abc import MutableMapping
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, Iterator, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _glint
+from ._errors import SceneError
+from ._glint import DEFAULT_PASS_SPP, Scene, Session
+from ._denoise import denoise
+
+__all__ = [
+    "DEFAULT_PASS_SPP",
+    "RenderResult",
+    "Scene",
+    "SceneError",
+    "SceneParameters",
+    "Session",
+    "denoise",
+    "load_dict",
+    "load_file",
+    "read_image",
+    "render",
+    "traverse",
+    "write_image",
+]
+
+AOV_NAMES: Tuple[str, ...] = tuple(_glint.AOV_NAMES)
+
+
+def _path(value: Any, arg: str) -> str:
+    if not isinstance(value, (str, os.PathLike)):
+        raise TypeError(f"{arg} must be a path (str or os.PathLike), not {type(value).__name__}")
+    return os.fspath(value)
+
+
+def load_file(path: Union[str, os.PathLike], **defines: Any) -> Scene:
+    """Reads a scene file of any format glint reads (.json, Mitsuba .xml, .obj, .ply).
+
+    Keyword arguments override the Mitsuba scene's ``<default>`` values, as the command
+    line's ``-D name=value`` does (``spp=64``); they are an error for other formats.
+    Raises SceneError (with ``.file``, ``.line``) for a scene that cannot be read.
+    """
+    path = _path(path, "path")
+
+    def text(v: Any) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, (str, int, float)):
+            return str(v)
+        raise TypeError(f"define {v!r}: expected a str, int, float or bool")
+
+    return _glint.load_file(path, [(k, text(v)) for k, v in defines.items()])
+
+
+def _json_default(o: Any) -> Any:
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.generic):
+        return o.item()
+    raise TypeError(f"a {type(o).__name__} in the scene dict cannot be written as JSON")
+
+
+def _mesh_arrays(index: int, shape: Mapping[str, Any]) -> Dict[str, Any]:
+    """The arrays of an in-memory mesh shape, checked and converted for the Rust side."""
+
+    def array(name: str, dtype: Any, cols: int, required: bool) -> Optional[np.ndarray]:
+        v = shape.get(name)
+        if v is None:
+            if required:
+                raise ValueError(f"shapes[{index}] (mesh): needs '{name}'")
+            return None
+        a = np.asarray(v)
+        if a.ndim != 2 or a.shape[1] != cols:
+            raise ValueError(f"shapes[{index}].{name}: expected shape (N, {cols}), got {a.shape}")
+        if dtype == np.uint32:
+            if not np.issubdtype(a.dtype, np.integer):
+                raise TypeError(f"shapes[{index}].{name}: expected integers, got {a.dtype}")
+            if a.size and (a.min() < 0 or a.max() > np.iinfo(np.uint32).max):
+                raise ValueError(f"shapes[{index}].{name}: indices must be non-negative 32-bit")
+        return np.ascontiguousarray(a, dtype=dtype)
+
+    out = {
+        "index": index,
+        "positions": array("positions", np.float32, 3, True),
+        "indices": array("indices", np.uint32, 3, True),
+        "normals": array("normals", np.float32, 3, False),
+        "uvs": array("uvs", np.float32, 2, False),
+    }
+    if out["normals"] is not None and len(out["normals"]) != len(out["positions"]):
+        raise ValueError(f"shapes[{index}].normals: one per position expected")
+    if out["uvs"] is not None and len(out["uvs"]) != len(out["positions"]):
+        raise ValueError(f"shapes[{index}].uvs: one per position expected")
+    return out
+
+
+def load_dict(d: Mapping[str, Any], base_dir: Union[str, os.PathLike] = ".") -> Scene:
+    """Makes a scene from a dict with the schema of glint's JSON scenes (docs/scene-format.md).
+
+    Relative file names resolve against ``base_dir``. numpy arrays may stand for lists.
+    A shape may also be an in-memory mesh: ``{"type": "mesh", "positions": (N, 3) floats,
+    "indices": (M, 3) ints, "normals": (N, 3) (optional), "uvs": (N, 2) (optional)}`` with
+    the other shape keys (material, transform, emission, ...) as usual.
+    """
+    if not isinstance(d, Mapping):
+        raise TypeError(f"d must be a dict, not {type(d).__name__}")
+    base = _path(base_dir, "base_dir")
+    d = dict(d)
+    meshes = []
+    shapes = d.get("shapes")
+    if isinstance(shapes, (list, tuple)):
+        replaced = []
+        for i, s in enumerate(shapes):
+            if isinstance(s, Mapping) and s.get("type") == "mesh":
+                meshes.append(_mesh_arrays(i, s))
+                # The JSON reader sees a placeholder with the shape's other keys; its
+                # geometry is then replaced by the arrays.
+                rest = {k: v for k, v in s.items() if k not in ("positions", "indices", "normals", "uvs")}
+                rest["type"] = "rectangle"
+                replaced.append(rest)
+            else:
+                replaced.append(s)
+        d["shapes"] = replaced
+    text = json.dumps(d, default=_json_default)
+    return _glint.load_json(text, os.path.join(base, "<dict>.json"), meshes)
+
+
+@dataclass
+class RenderResult:
+    """What ``render`` returns.
+
+    ``image``: float32 (height, width, 3), linear RGB. ``aovs``: layer name -> float32
+    (height, width, channels). ``spp``: samples per pixel rendered (fewer than asked if
+    the time limit was reached). ``stats``: rays, seconds and the scene's build counters
+    (``mesh_bvh_builds``, ``top_level_builds``: BVHs built for this scene so far).
+    """
+
+    image: np.ndarray
+    aovs: Dict[str, np.ndarray] = field(default_factory=dict)
+    spp: int = 0
+    stats: Dict[str, Any] = field(default_factory=dict)
+
+
+def _check_scene(scene: Any) -> Scene:
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a glint.Scene (from load_file or load_dict), not {type(scene).__name__}")
+    return scene
+
+
+def _check_int(value: Any, arg: str, minimum: int) -> Optional[int]:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{arg} must be an int, not {type(value).__name__}")
+    if value < minimum:
+        raise ValueError(f"{arg} must be at least {minimum}, got {value}")
+    return int(value)
+
+
+def render(
+    scene: Scene,
+    spp: Optional[int] = None,
+    seed: int = 0,
+    time_limit: Optional[float] = None,
+    aovs: Sequence[str] = (),
+    threads: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> RenderResult:
+    """Renders the scene and returns a RenderResult.
+
+    ``spp``: samples per pixel (default: the scene's). ``seed``: the random seed.
+    ``time_limit``: seconds after which no pass starts. ``aovs``: extra layers (albedo,
+    normal, depth, position, variance, spp, bvh-cost). ``threads``: worker threads
+    (default: all cores). ``progress(done_spp, total_spp)``: called at most four times a
+    second and once at the end. Ctrl-C raises KeyboardInterrupt.
+    """
+    s = make_session(scene, spp=spp, seed=seed, aovs=aovs, threads=threads)
+    if time_limit is not None and not isinstance(time_limit, (int, float)):
+        raise TypeError(f"time_limit must be a number of seconds, not {type(time_limit).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError("progress must be callable")
+    s.render_passes(None, time_limit, progress)
+    return RenderResult(image=s.image(), aovs=dict(s.aovs()), spp=s.spp, stats=dict(s.stats))
+
+
+def make_session(
+    scene: Scene, spp: Optional[int] = None, seed: int = 0, aovs: Sequence[str] = (), threads: Optional[int] = None
+) -> Session:
+    """``Session(...)`` with its arguments checked (TypeError naming the argument)."""
+    _check_scene(scene)
+    spp = _check_int(spp, "spp", 1)
+    seed = _check_int(seed, "seed", 0)
+    threads = _check_int(threads, "threads", 1)
+    if isinstance(aovs, str) or not all(isinstance(a, str) for a in aovs):
+        raise TypeError("aovs must be a sequence of layer names (str)")
+    return Session(scene, spp, seed, list(aovs), threads)
+
+
+def read_image(path: Union[str, os.PathLike]) -> np.ndarray:
+    """Reads a PNG (decoded from sRGB), EXR or PFM file: float32 (height, width, 3), linear."""
+    return _glint.read_image(_path(path, "path"))
+
+
+def _layer_channels(name: str, channels: int) -> list:
+    known = {"albedo": "RGB", "variance": "RGB", "normal": "XYZ", "position": "XYZ", "depth": "Z"}
+    suffixes = known.get(name, "RGB" if channels == 3 else "Y" if channels == 1 else None)
+    if suffixes is None or len(suffixes) != channels:
+        suffixes = [str(i) for i in range(channels)]
+    return [f"{name}.{c}" for c in suffixes]
+
+
+def write_image(
+    path: Union[str, os.PathLike], image: np.ndarray, aovs: Optional[Mapping[str, np.ndarray]] = None
+) -> None:
+    """Writes a (height, width, 3) linear RGB image as PNG (sRGB, 8 bit), EXR or PFM,
+    chosen by extension. ``aovs`` (name -> (height, width, channels)) are written beside it
+    as EXR layers (``albedo.R``, ``normal.X``, ...): EXR only."""
+    path = _path(path, "path")
+    if not isinstance(image, np.ndarray):
+        raise TypeError(f"image must be a numpy array, not {type(image).__name__}")
+    if image.ndim != 3 or image.shape[2] != 3:
+        raise ValueError(f"image: expected shape (height, width, 3), got {image.shape}")
+    layers = []
+    for name, a in (aovs or {}).items():
+        a = np.asarray(a, dtype=np.float32)
+        if a.ndim == 2:
+            a = a[:, :, None]
+        layers.append((_layer_channels(name, a.shape[2]), np.ascontiguousarray(a)))
+    if layers and not path.lower().endswith(".exr"):
+        raise ValueError("aovs can be written to an .exr file only")
+    _glint.write_image(path, np.ascontiguousarray(image, dtype=np.float32), layers)
+
+
+class SceneParameters(MutableMapping):
+    """The editable parameters of a scene, by name (see ``traverse``).
+
+    Values are floats, colours (numpy arrays of 3) or 4x4 matrices (numpy arrays).
+    Assigning stores the value; ``update()`` applies every stored change at once and
+    rebuilds as little as it can: material, emission, light and camera edits rebuild no
+    BVH; a shape's ``to_world`` rebuilds only the top-level BVH.
+    """
+
+    def __init__(self, scene: Scene):
+        self._scene = _check_scene(scene)
+        self._values: Dict[str, Any] = {}
+        self._kinds: Dict[str, str] = {}
+        self._pending: Dict[str, Any] = {}
+        self._reload()
+
+    def _reload(self) -> None:
+        self._values.clear()
+        for name, v in self._scene._params():
+            if isinstance(v, tuple):
+                kind, data = v
+                self._kinds[name] = kind
+                self._values[name] = np.array(data, dtype=np.float64)
+            else:
+                self._kinds[name] = "float"
+                self._values[name] = float(v)
+
+    def __getitem__(self, key: str) -> Any:
+        if key in self._pending:
+            v = self._pending[key]
+        else:
+            v = self._values[key]
+        return v.copy() if isinstance(v, np.ndarray) else v
+
+    def __setitem__(self, key: str, value: Any) -> None:
+        if key not in self._values:
+            raise KeyError(f"no parameter called {key!r}")
+        kind = self._kinds[key]
+        if kind == "float":
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+                raise TypeError(f"{key} takes a number, not {type(value).__name__}")
+            self._pending[key] = float(value)
+            return
+        try:
+            a = np.array(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise TypeError(f"{key} takes {'3 numbers' if kind == 'color' else 'a 4x4 matrix'}, not {value!r}") from None
+        if kind == "color" and a.ndim == 0:
+            a = np.full(3, float(a))
+        expected = (3,) if kind == "color" else (4, 4)
+        if a.shape != expected:
+            raise TypeError(f"{key} takes an array of shape {expected}, not {a.shape}")
+        self._pending[key] = a
+
+    def __delitem__(self, key: str) -> None:
+        raise TypeError("scene parameters cannot be removed")
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def __repr__(self) -> str:
+        lines = [f"  {k!r}: {self[k]!r}," for k in self]
+        return "SceneParameters({\n" + "\n".join(lines) + "\n})"
+
+    def update(self, other: Any = (), **kwargs: Any) -> None:  # type: ignore[override]
+        """Stores the given values (as ``dict.update``), then applies every stored change
+        to the scene. Raises SceneError (nothing changed) for values the scene cannot take."""
+        for k, v in dict(other, **kwargs).items():
+            self[k] = v
+        edits = []
+        for k, v in self._pending.items():
+            kind = self._kinds[k]
+            values = [v] if kind == "float" else [float(x) for x in np.ravel(v)]
+            edits.append((k, kind, values))
+        if edits:
+            self._scene._set_params(edits)
+        self._pending.clear()
+        self._reload()
+
+
+def traverse(scene: Scene) -> SceneParameters:
+    """The scene's editable parameters, a dict-like SceneParameters.
+
+    Names: ``materials.NAME.reflectance`` (and ``kd``, ``diffuse`` when constant, ``ks``,
+    ``exponent``, ``eta``, ``k``, ``specular``, ``reflect``, ``transmit``, ``alpha``),
+    ``lights.I.radiance`` / ``intensity`` / ``irradiance`` / ``scale``,
+    ``shapes.I.emission``, ``shapes.I.to_world``, ``camera.fov``, ``camera.to_world``.
+    Assign, then call ``update()``.
+    """
+    return SceneParameters(scene)

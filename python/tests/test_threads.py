@@ -1,0 +1,50 @@
+"""The GIL is released while rendering, and Ctrl-C stops a render."""
+
+import _thread
+import threading
+
+import numpy as np
+import pytest
+
+import glint
+from conftest import cornell
+
+
+def test_other_python_threads_run_while_rendering():
+    s = cornell(64)
+    glint.render(s, spp=1)  # build first: only the render itself is measured
+    counter = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            counter[0] += 1
+            stop.wait(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        start = counter[0]
+        glint.render(s, spp=64)
+        during = counter[0] - start
+    finally:
+        stop.set()
+        t.join()
+    # Were the GIL held, the counting thread could not run at all during the render.
+    assert during > 10
+
+
+def test_keyboard_interrupt_keeps_the_session_usable():
+    session = glint.Session(cornell(64), spp=100000)
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            session.render_passes()
+    finally:
+        timer.cancel()
+    done = session.spp
+    assert 0 < done < 100000
+    assert session.render_passes(2) == 2
+    assert session.spp == done + 2
+    assert np.isfinite(session.image()).all()
