@@ -100,6 +100,10 @@ pub struct RenderArgs {
     /// Extra layers: albedo, normal, depth, position, variance, spp, bvh-cost (comma-separated).
     #[arg(long, value_delimiter = ',')]
     pub aov: Vec<Aov>,
+    /// Denoise with Intel Open Image Denoise (renders the albedo and normal layers to guide
+    /// it; EXR output keeps the noisy image as the layer `noisy`).
+    #[arg(long)]
+    pub denoise: bool,
     /// Adaptive sampling: pixels whose relative standard error is under the threshold stop.
     #[arg(long)]
     pub adaptive: bool,

@@ -2,6 +2,7 @@
 
 mod bench;
 mod commands;
+mod denoise;
 mod info;
 mod merge;
 mod meshsrc;

@@ -68,6 +68,7 @@ pub fn write_image_and_layers(image: &Image, film: &Film, out: &Path, extra: &[(
             }
             write_exr_channels(out, w, h, &channels)
         }
+        // Extra layers (the noisy image of a denoised render) are EXR-only.
         ImageFormat::Png | ImageFormat::Pfm => {
             glint::io::write_image(image, out)?;
             for l in &layers {

@@ -8,7 +8,7 @@ use crate::outputs::{output_files, temp_files, write_film_image};
 use crate::progress::ProgressBar;
 use crate::signals;
 use glint::describe::{IntegratorDesc, PathSettings, SceneDesc, WhittedSettings};
-use glint::render::{Adaptive, Film};
+use glint::render::{Adaptive, Aov, Film};
 use glint::session::{FilmOptions, RenderControl, RenderReport, Session};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -27,6 +27,16 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
         return Err("--pass-spp must be at least 1".into());
     }
     check_run_args(&a.run)?;
+    // Found before anything is rendered: a missing denoiser is one line, and no output.
+    let denoiser = if a.denoise { Some(crate::denoise::Oidn::load()?) } else { None };
+    let mut aovs = a.aov.clone();
+    if a.denoise {
+        for needed in [Aov::Albedo, Aov::Normal] {
+            if !aovs.contains(&needed) {
+                aovs.push(needed);
+            }
+        }
+    }
     set_threads(a.threads, a.quiet)?;
     let start = Instant::now();
     let mut session = a.scene.open()?;
@@ -37,7 +47,7 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
             return Err(format!("--crop {c} is outside the {}x{} image", desc.film.width, desc.film.height).into());
         }
     }
-    for out in output_files(&a.output, &a.aov) {
+    for out in output_files(&a.output, &aovs) {
         check_output(&out, desc)?;
     }
     for f in a.run.checkpoint.iter().chain(&a.run.film_out) {
@@ -48,7 +58,7 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
             eprintln!("glint: warning: {w}");
         }
     }
-    let film = session.new_film(&FilmOptions { pass_spp: a.pass_spp, region: a.crop, aovs: a.aov.clone() })?;
+    let film = session.new_film(&FilmOptions { pass_spp: a.pass_spp, region: a.crop, aovs })?;
     if let Some(p) = &a.passes {
         if p.end > film.pass_count() {
             return Err(format!("--passes {}..{}: the render has {} passes", p.start, p.end, film.pass_count()).into());
@@ -61,6 +71,7 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
         output: a.output.clone(),
         run: a.run.clone(),
         quiet: a.quiet,
+        denoiser,
     };
     run(session, film, a.passes.clone(), adaptive, start, &job)
 }
@@ -96,7 +107,7 @@ pub fn resume_cmd(a: ResumeArgs) -> Result<(), CliError> {
     }
     let adaptive = session.adaptive();
     let name = session.description().source.as_ref().map_or("scene".to_string(), |p| p.display().to_string());
-    let job = Job { scene_name: name, output, run: run_args, quiet: a.quiet };
+    let job = Job { scene_name: name, output, run: run_args, quiet: a.quiet, denoiser: None };
     run(session, film, None, adaptive, start, &job)
 }
 
@@ -106,6 +117,7 @@ struct Job {
     output: PathBuf,
     run: RunArgs,
     quiet: bool,
+    denoiser: Option<crate::denoise::Oidn>,
 }
 
 fn check_run_args(r: &RunArgs) -> Result<(), CliError> {
@@ -201,7 +213,15 @@ fn finish(
     job: &Job,
 ) -> Result<(), CliError> {
     let interrupted = signals::received().filter(|_| report.cancelled);
-    write_film_image(film, &job.output, &[])?;
+    match &job.denoiser {
+        None => write_film_image(film, &job.output, &[])?,
+        Some(oidn) => {
+            let noisy = film.image();
+            let layer = |aov: Aov| film.aov(aov).map(|l| layer_image(&l)).ok_or("denoise: a guide layer is missing");
+            let clean = oidn.denoise(&noisy, &layer(Aov::Albedo)?, &layer(Aov::Normal)?)?;
+            crate::outputs::write_image_and_layers(&clean, film, &job.output, &[("noisy".to_string(), noisy)])?;
+        }
+    }
     for f in job.run.checkpoint.iter().chain(&job.run.film_out) {
         glint::render::write_film(f, film, meta)?;
     }
@@ -239,6 +259,15 @@ fn finish(
         );
     }
     Ok(())
+}
+
+/// A three-channel layer as an image.
+fn layer_image(l: &glint::render::AovImage) -> glint::io::Image {
+    let mut img = glint::io::Image::new(l.width, l.height);
+    for (p, c) in img.pixels.iter_mut().zip(l.data.chunks_exact(3)) {
+        *p = glint::math::Rgb { r: c[0], g: c[1], b: c[2] };
+    }
+    img
 }
 
 /// More threads than this many times the cores only cost memory and scheduling.
