@@ -276,3 +276,24 @@ fn outputs_are_checked_before_the_render() {
     assert_eq!(std::fs::read(&tex).unwrap(), before, "the texture was overwritten");
     assert!(std::fs::read_to_string(&f).unwrap().contains("camera"), "the scene file was overwritten");
 }
+
+#[test]
+fn whitted_in_glass_does_not_double_its_work_forever() {
+    // Glass spheres inside a glass box: every hit splits into reflection and refraction, so
+    // depth 3000 would be 2^3000 rays without the per-camera-ray budget.
+    let d = Dir::new("glass");
+    let f = d.write(
+        "glass.json",
+        &json(
+            r#"{ "type": "cube", "material": "g", "transform": [ { "scale": 3 } ] },
+               { "type": "sphere", "material": "g", "radius": 0.5 },
+               { "type": "sphere", "material": "g", "radius": 0.3, "center": [1, 1, 0] }"#,
+            r#"{ "type": "point", "position": [0, 2, 1], "intensity": 5 }"#,
+            r#""integrator": { "type": "whitted", "max_depth": 3000 },"#,
+        )
+        .replace(r#""white": {"#, r#""g": { "type": "dielectric", "ior": 1.5 }, "white": {"#)
+        .replace("\"position\": [0, 0, 5]", "\"position\": [0, 0, 2]"),
+    );
+    let o = run(&["render", &f, "-o", &d.out(), "--spp", "1", "--width", "4", "--height", "4", "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -18,10 +18,14 @@ pub fn li(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &
     // random numbers and the rounding (and so the image) are those of that form.
     let mut stack: Vec<Frame> = Vec::new();
     let mut ray = *ray;
+    let mut budget = MAX_WHITTED_RAYS;
     'trace: loop {
         let depth = stack.len() as u32 + 1;
+        budget -= 1;
         let mut value = match shade(s, scene, &ray, rng, c, depth) {
             Node::Done(l) => l,
+            // Out of rays: this hit keeps its emission and direct light only.
+            Node::Branch(frame, _) if budget == 0 => frame.l,
             Node::Branch(frame, child) => {
                 stack.push(frame);
                 ray = child;
@@ -33,7 +37,7 @@ pub fn li(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &
             match frame.waiting {
                 Waiting::Reflection { reflect, reflectance, refraction } => {
                     frame.l += reflect * value * reflectance;
-                    if let Some(r) = refraction {
+                    if let Some(r) = refraction.filter(|_| budget > 0) {
                         frame.waiting = Waiting::Refraction { transmit: r.transmit, scale: r.scale };
                         ray = r.ray;
                         continue 'trace;
@@ -48,6 +52,11 @@ pub fn li(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &
         return value;
     }
 }
+
+/// The most rays one camera ray may lead to. Glass doubles the rays at every bounce, so a deep
+/// `max_depth` would otherwise mean 2^depth rays per pixel; past the budget a hit keeps only
+/// its emission and direct light. Depth 13 in glass everywhere fits.
+pub const MAX_WHITTED_RAYS: u32 = 1 << 14;
 
 /// A hit whose radiance so far is `l`, waiting for the radiance of a child ray.
 struct Frame {

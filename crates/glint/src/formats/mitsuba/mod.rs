@@ -66,7 +66,16 @@ struct Reader<'a> {
 
 pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    let tree = xml::load_tree(path, &defines)?;
+    describe_tree(path, xml::load_tree(path, &defines)?)
+}
+
+/// Reads a Mitsuba scene given as text (for fuzzing and in-memory scenes); `path` names it.
+pub fn read_str(text: &str, path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
+    let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
+    describe_tree(path, xml::load_tree_str(text, path, &defines)?)
+}
+
+fn describe_tree(path: &Path, tree: xml::SceneTree) -> Result<SceneDesc, Error> {
     let root = tree.root;
     let mut r = Reader {
         named: HashMap::new(),

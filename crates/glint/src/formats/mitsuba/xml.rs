@@ -139,7 +139,15 @@ pub struct SceneTree {
 /// Loads a scene file: parses it, expands includes, applies version upgrades, collects
 /// defaults (overridden by `defines`) and substitutes `$name` references.
 pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<SceneTree, Error> {
-    let mut root = parse_file(path)?;
+    load_tree_from(parse_file(path)?, defines)
+}
+
+/// [`load_tree`] for a scene given as text (`path` names it, and includes resolve next to it).
+pub fn load_tree_str(text: &str, path: &Path, defines: &[(String, String)]) -> Result<SceneTree, Error> {
+    load_tree_from(parse_str(text, path)?, defines)
+}
+
+fn load_tree_from(mut root: Element, defines: &[(String, String)]) -> Result<SceneTree, Error> {
     let mut included = Includes::default();
     if root.tag != "scene" {
         return Err(root.err(format!("the root element is <{}>, expected <scene>", root.tag)));
