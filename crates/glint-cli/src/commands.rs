@@ -138,7 +138,8 @@ pub struct RunArgs {
 #[derive(Args)]
 pub struct ResumeArgs {
     /// A checkpoint written by `glint render --checkpoint`.
-    pub checkpoint: PathBuf,
+    #[arg(value_name = "CHECKPOINT")]
+    pub from: PathBuf,
     /// Output image (default: the one the render was writing).
     #[arg(short, long)]
     pub output: Option<PathBuf>,

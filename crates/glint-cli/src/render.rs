@@ -80,13 +80,13 @@ pub fn resume_cmd(a: ResumeArgs) -> Result<(), CliError> {
     check_run_args(&a.run)?;
     set_threads(a.threads, a.quiet)?;
     let start = Instant::now();
-    let resumed = Session::resume_job(&a.checkpoint)?;
+    let resumed = Session::resume_job(&a.from)?;
     let (mut session, mut film) = (resumed.session, resumed.film);
     let output = match (a.output, resumed.job.output) {
         (Some(o), _) => o,
         (None, Some(o)) => o,
         (None, None) => {
-            return Err(format!("{}: the checkpoint names no output; give -o", a.checkpoint.display()).into())
+            return Err(format!("{}: the checkpoint names no output; give -o", a.from.display()).into())
         }
     };
     glint::io::image_io::ImageFormat::from_path(&output)?;
@@ -103,7 +103,7 @@ pub fn resume_cmd(a: ResumeArgs) -> Result<(), CliError> {
     // A resumed render goes on checkpointing into the file it came from.
     let mut run_args = a.run.clone();
     if run_args.checkpoint.is_none() {
-        run_args.checkpoint = Some(a.checkpoint.clone());
+        run_args.checkpoint = Some(a.from.clone());
     }
     let adaptive = session.adaptive();
     let name = session.description().source.as_ref().map_or("scene".to_string(), |p| p.display().to_string());
