@@ -85,9 +85,7 @@ pub fn resume_cmd(a: ResumeArgs) -> Result<(), CliError> {
     let output = match (a.output, resumed.job.output) {
         (Some(o), _) => o,
         (None, Some(o)) => o,
-        (None, None) => {
-            return Err(format!("{}: the checkpoint names no output; give -o", a.from.display()).into())
-        }
+        (None, None) => return Err(format!("{}: the checkpoint names no output; give -o", a.from.display()).into()),
     };
     glint::io::image_io::ImageFormat::from_path(&output)?;
     if let Some(spp) = a.spp {

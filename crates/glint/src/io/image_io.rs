@@ -59,19 +59,10 @@ pub fn write_image(img: &Image, path: &Path) -> Result<(), String> {
     if !dir.is_dir() {
         return Err(format!("{}: folder {} does not exist", path.display(), dir.display()));
     }
-    let tmp = super::layers::temp_path(path);
-    let result = match format {
-        ImageFormat::Png => write_png(img, &tmp),
-        ImageFormat::Exr => write_exr(img, &tmp),
-        ImageFormat::Pfm => write_pfm(img, &tmp),
-    };
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!("{}: {e}", path.display()));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", path.display())
+    super::layers::write_atomically(path, |tmp| match format {
+        ImageFormat::Png => write_png(img, tmp),
+        ImageFormat::Exr => write_exr(img, tmp),
+        ImageFormat::Pfm => write_pfm(img, tmp),
     })
 }
 

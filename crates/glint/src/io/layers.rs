@@ -18,6 +18,20 @@ pub fn temp_path(path: &Path) -> PathBuf {
     dir.join(format!(".{file_name}.{}.tmp", std::process::id()))
 }
 
+/// Runs `write` on the temporary path of `path`, then renames the result into place; the
+/// temporary file is removed on any error, so `path` is never half-written.
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+    let tmp = temp_path(path);
+    if let Err(e) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(format!("{}: {e}", path.display()));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: {e}", path.display())
+    })
+}
+
 /// Writes a float EXR with the given channels (all `width * height` long).
 pub fn write_exr_channels(path: &Path, width: usize, height: usize, channels: &[Channel]) -> Result<(), String> {
     use exr::prelude::*;
@@ -33,14 +47,5 @@ pub fn write_exr_channels(path: &Path, width: usize, height: usize, channels: &[
         channels.iter().map(|c| AnyChannel::new(c.name.as_str(), FlatSamples::F32(c.values.to_vec()))).collect();
     let layer =
         Layer::new((width, height), LayerAttributes::default(), Encoding::FAST_LOSSLESS, AnyChannels::sort(list));
-    let tmp = temp_path(path);
-    let result = exr::prelude::Image::from_layer(layer).write().to_file(&tmp).map_err(|e| e.to_string());
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!("{}: {e}", path.display()));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", path.display())
-    })
+    write_atomically(path, |tmp| exr::prelude::Image::from_layer(layer).write().to_file(tmp).map_err(|e| e.to_string()))
 }
