@@ -115,7 +115,19 @@ fn render_pass(
     } else {
         aov_sums.chunks_mut(band_pixels * stride).collect()
     };
-    let job = PassJob { scene, integrator, settings, region, tile, samples, layers: &layers, stride, progress };
+    let wants_first_hit = layers.iter().any(|(a, _)| *a != Aov::BvhCost);
+    let job = PassJob {
+        scene,
+        integrator,
+        settings,
+        region,
+        tile,
+        samples,
+        layers: &layers,
+        wants_first_hit,
+        stride,
+        progress,
+    };
     pixels
         .par_chunks_mut(band_pixels)
         .zip(aov_bands.into_par_iter())
@@ -153,6 +165,8 @@ struct PassJob<'a> {
     tile: u32,
     samples: Range<u32>,
     layers: &'a [(Aov, usize)],
+    /// Some layer needs the camera ray's first hit (every one but bvh-cost).
+    wants_first_hit: bool,
     stride: usize,
     progress: &'a dyn Progress,
 }
@@ -187,7 +201,6 @@ impl PassJob<'_> {
     fn pixel(&self, x: u32, y: u32, sums: &mut PixelSums, aov_sums: &mut [i128], counts: &mut TileCounts) {
         let (scene, settings) = (self.scene, self.settings);
         let pixel = y as u64 * scene.camera.width as u64 + x as u64;
-        let wants_first_hit = self.layers.iter().any(|(a, _)| *a != Aov::BvhCost);
         for s in self.samples.clone() {
             let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
             let off = settings.filter.sample(rng.next_2d());
@@ -203,7 +216,7 @@ impl PassJob<'_> {
             if self.layers.is_empty() {
                 continue;
             }
-            let hit = if wants_first_hit { first_hit(scene, &ray) } else { crate::integrators::FirstHit::NONE };
+            let hit = if self.wants_first_hit { first_hit(scene, &ray) } else { crate::integrators::FirstHit::NONE };
             for &(aov, off) in self.layers {
                 let values: [f32; 3] = match aov {
                     Aov::Albedo => hit.albedo.to_array(),
