@@ -1,7 +1,8 @@
 //! Scheduling: each pass is cut into bands of rows (rendered tile by tile) that rayon renders
-//! in parallel, straight into a [`Film`]. Every camera sample draws its random numbers from a generator keyed by
-//! (seed, pixel, sample index), and the film's sums are exact (fixed point), so the image is
-//! bit-identical whatever the number of threads, passes, regions or merges.
+//! in parallel, straight into a [`Film`]. Every camera sample draws its random numbers from a
+//! generator keyed by (seed, pixel, sample index), and the film's sums are exact (fixed
+//! point), so the image is bit-identical whatever the number of threads, passes, regions or
+//! merges.
 
 mod aov;
 pub mod checkpoint;
