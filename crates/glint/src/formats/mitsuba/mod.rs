@@ -72,7 +72,19 @@ pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
 /// Reads a Mitsuba scene given as text (for fuzzing and in-memory scenes); `path` names it.
 pub fn read_str(text: &str, path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    describe_tree(path, xml::load_tree_str(text, path, &defines)?)
+    describe_tree(path, xml::load_tree_str(text, path, &defines, xml::IncludeSource::Disk)?)
+}
+
+/// [`read_str`] with `<include>`s read from `files` (path to text) instead of the disk: a
+/// path that is not a key does not exist.
+pub fn read_str_with_includes(
+    text: &str,
+    path: &Path,
+    defines: &[Define],
+    files: &HashMap<std::path::PathBuf, String>,
+) -> Result<SceneDesc, Error> {
+    let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
+    describe_tree(path, xml::load_tree_str(text, path, &defines, xml::IncludeSource::Memory(files))?)
 }
 
 fn describe_tree(path: &Path, tree: xml::SceneTree) -> Result<SceneDesc, Error> {

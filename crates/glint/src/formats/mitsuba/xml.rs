@@ -40,10 +40,32 @@ impl Element {
     }
 }
 
-/// Parses one file into its root element (no includes or substitution yet).
-fn parse_file(path: &Path) -> Result<Element, Error> {
-    let text = crate::formats::read_text(path)?;
-    parse_str(&text, path)
+/// Where included files are read from: the file system, or a map of path to text (fuzzing,
+/// scenes held in memory), in which a path that is not a key does not exist.
+#[derive(Clone, Copy)]
+pub enum IncludeSource<'a> {
+    Disk,
+    Memory(&'a HashMap<PathBuf, String>),
+}
+
+impl IncludeSource<'_> {
+    fn exists(&self, path: &Path) -> bool {
+        match self {
+            IncludeSource::Disk => path.exists(),
+            IncludeSource::Memory(files) => files.contains_key(path),
+        }
+    }
+
+    /// Parses one file into its root element (no includes or substitution yet).
+    fn parse(&self, path: &Path) -> Result<Element, Error> {
+        match self {
+            IncludeSource::Disk => parse_str(&crate::formats::read_text(path)?, path),
+            IncludeSource::Memory(files) => match files.get(path) {
+                Some(text) => parse_str(text, path),
+                None => Err(Error::at(&SourceLoc::file(path), "file does not exist")),
+            },
+        }
+    }
 }
 
 pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
@@ -131,6 +153,7 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
 }
 
 /// A scene file's tree and the files it included.
+#[derive(Debug)]
 pub struct SceneTree {
     pub root: Element,
     pub included: Vec<PathBuf>,
@@ -139,15 +162,21 @@ pub struct SceneTree {
 /// Loads a scene file: parses it, expands includes, applies version upgrades, collects
 /// defaults (overridden by `defines`) and substitutes `$name` references.
 pub fn load_tree(path: &Path, defines: &[(String, String)]) -> Result<SceneTree, Error> {
-    load_tree_from(parse_file(path)?, defines)
+    load_tree_from(IncludeSource::Disk.parse(path)?, defines, IncludeSource::Disk)
 }
 
-/// [`load_tree`] for a scene given as text (`path` names it, and includes resolve next to it).
-pub fn load_tree_str(text: &str, path: &Path, defines: &[(String, String)]) -> Result<SceneTree, Error> {
-    load_tree_from(parse_str(text, path)?, defines)
+/// [`load_tree`] for a scene given as text (`path` names it, and includes resolve next to it,
+/// read from `source`).
+pub fn load_tree_str(
+    text: &str,
+    path: &Path,
+    defines: &[(String, String)],
+    source: IncludeSource<'_>,
+) -> Result<SceneTree, Error> {
+    load_tree_from(parse_str(text, path)?, defines, source)
 }
 
-fn load_tree_from(mut root: Element, defines: &[(String, String)]) -> Result<SceneTree, Error> {
+fn load_tree_from(mut root: Element, defines: &[(String, String)], source: IncludeSource<'_>) -> Result<SceneTree, Error> {
     let mut included = Includes::default();
     if root.tag != "scene" {
         return Err(root.err(format!("the root element is <{}>, expected <scene>", root.tag)));
@@ -161,7 +190,7 @@ fn load_tree_from(mut root: Element, defines: &[(String, String)]) -> Result<Sce
     if major > 3 {
         return Err(root.err(format!("scene version {version} is newer than the 3.x that glint reads")));
     }
-    expand_includes(&mut root, 0, &mut included)?;
+    expand_includes(&mut root, 0, &mut included, source)?;
     if major < 2 {
         upgrade_from_v0(&mut root);
     }
@@ -190,7 +219,7 @@ struct Includes {
     expanded: usize,
 }
 
-fn expand_includes(el: &mut Element, depth: usize, included: &mut Includes) -> Result<(), Error> {
+fn expand_includes(el: &mut Element, depth: usize, included: &mut Includes, source: IncludeSource<'_>) -> Result<(), Error> {
     if depth > 16 {
         return Err(el.err("includes nested more than 16 deep (a cycle?)"));
     }
@@ -203,21 +232,21 @@ fn expand_includes(el: &mut Element, depth: usize, included: &mut Includes) -> R
             }
             let name = c.required("filename")?;
             let path = c.file.parent().unwrap_or(Path::new(".")).join(name);
-            if !path.exists() {
+            if !source.exists(&path) {
                 return Err(c.err(format!("included file '{}' does not exist", path.display())));
             }
-            let mut inc = parse_file(&path)?;
+            let mut inc = source.parse(&path)?;
             if !included.files.contains(&path) {
                 included.files.push(path.clone());
             }
-            expand_includes(&mut inc, depth + 1, included)?;
+            expand_includes(&mut inc, depth + 1, included, source)?;
             if inc.tag == "scene" {
                 out.extend(inc.children);
             } else {
                 out.push(inc);
             }
         } else {
-            expand_includes(&mut c, depth, included)?;
+            expand_includes(&mut c, depth, included, source)?;
             out.push(c);
         }
     }
@@ -270,6 +299,29 @@ mod tests {
         assert_eq!(shape.children[0].attr("name"), Some("to_world"));
         assert_eq!(shape.children[0].children[0].tag, "lookat");
         assert_eq!(shape.children[1].attr("value"), Some("3"));
+    }
+
+    #[test]
+    fn includes_are_read_from_memory_and_nothing_else() {
+        let main = Path::new("/in-memory/scene.xml");
+        let mut files = HashMap::new();
+        files.insert(
+            PathBuf::from("/in-memory/parts/a.xml"),
+            r#"<scene version="3.0.0"><include filename="b.xml"/><bsdf type="diffuse" id="x"/></scene>"#.to_string(),
+        );
+        files.insert(PathBuf::from("/in-memory/parts/b.xml"), r#"<bsdf type="diffuse" id="y"/>"#.to_string());
+        let text = r#"<scene version="3.0.0"><include filename="parts/a.xml"/></scene>"#;
+        let tree = load_tree_str(text, main, &[], IncludeSource::Memory(&files)).unwrap();
+        let ids: Vec<_> = tree.root.children.iter().filter_map(|c| c.attr("id")).collect();
+        assert_eq!(ids, ["y", "x"]);
+        assert_eq!(tree.included.len(), 2);
+        // A file on disk is not visible through a memory source.
+        let disk = std::env::temp_dir().join(format!("glint-xml-mem-{}.xml", std::process::id()));
+        std::fs::write(&disk, "<bsdf type=\"diffuse\"/>").unwrap();
+        let text = format!(r#"<scene version="3.0.0"><include filename="{}"/></scene>"#, disk.display());
+        let err = load_tree_str(&text, main, &[], IncludeSource::Memory(&files)).unwrap_err();
+        assert!(err.to_string().contains("does not exist"), "{err}");
+        std::fs::remove_file(&disk).ok();
     }
 }
 
