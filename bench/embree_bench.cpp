@@ -5,10 +5,19 @@
 // wide build uses (leaves of at most 4), once without spatial splits (binned SAH, like
 // glint) and once with them (HIGH quality), scored with glint's formula.
 //
+// Rays are traced through three of Embree's entry points: one ray at a time (rtcIntersect1,
+// rtcOccluded1), packets of 16 in the order of the ray set (rtcIntersect16, rtcOccluded16;
+// Embree runs them on its widest kernels), and streams of 4096 rays per call
+// (rtcIntersect1M, rtcOccluded1M, incoherent). Packet and stream hits are checked against
+// the single-ray hits. Flush-to-zero and denormals-are-zero are set, as Embree asks.
+//
 // usage: embree_bench TRIS.bin RAYS.bin [--hits OUT.bin] [--repeat N] [--quality high|medium] [--robust]
+//        embree_bench --isa   (prints the ISA Embree picks on this machine: its verbose report)
 // (--quality medium: Embree's binned SAH build without spatial splits; --robust: Embree's
 // watertight mode, RTC_SCENE_FLAG_ROBUST, the guarantee glint's triangle test always gives)
 #include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -139,7 +148,116 @@ static double generic_sah(RTCDevice dev, const float* tris, size_t n, bool spati
   return c;
 }
 
+static const size_t STREAM = 4096;
+
+static void load_ray(const float* r, RTCRay& ray) {
+  ray.org_x = r[0]; ray.org_y = r[1]; ray.org_z = r[2]; ray.tnear = r[3];
+  ray.dir_x = r[4]; ray.dir_y = r[5]; ray.dir_z = r[6]; ray.tfar = r[7];
+  ray.time = 0; ray.mask = 0xFFFFFFFF; ray.id = 0; ray.flags = 0;
+}
+
+// Closest hits through rtcIntersect16, 16 consecutive rays of the set per packet.
+static size_t closest_packets(RTCScene scene, const float* rays, size_t nray, std::vector<float>& hits) {
+  size_t hit_count = 0;
+  RTCIntersectContext ctx;
+  for (size_t base = 0; base < nray; base += 16) {
+    alignas(64) RTCRayHit16 rh;
+    alignas(64) int valid[16];
+    for (int k = 0; k < 16; k++) {
+      size_t i = base + k;
+      valid[k] = i < nray ? -1 : 0;
+      const float* r = rays + 8 * (i < nray ? i : base);
+      rh.ray.org_x[k] = r[0]; rh.ray.org_y[k] = r[1]; rh.ray.org_z[k] = r[2]; rh.ray.tnear[k] = r[3];
+      rh.ray.dir_x[k] = r[4]; rh.ray.dir_y[k] = r[5]; rh.ray.dir_z[k] = r[6]; rh.ray.tfar[k] = r[7];
+      rh.ray.time[k] = 0; rh.ray.mask[k] = 0xFFFFFFFF; rh.ray.id[k] = 0; rh.ray.flags[k] = 0;
+      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID; rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcInitIntersectContext(&ctx);
+    rtcIntersect16(valid, scene, &ctx, &rh);
+    for (int k = 0; k < 16 && base + k < nray; k++) {
+      bool hit = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+      hits[base + k] = hit ? rh.ray.tfar[k] : INFINITY;
+      hit_count += hit;
+    }
+  }
+  return hit_count;
+}
+
+static size_t occluded_packets(RTCScene scene, const float* rays, size_t nray) {
+  size_t occ = 0;
+  RTCIntersectContext ctx;
+  for (size_t base = 0; base < nray; base += 16) {
+    alignas(64) RTCRay16 ray;
+    alignas(64) int valid[16];
+    for (int k = 0; k < 16; k++) {
+      size_t i = base + k;
+      valid[k] = i < nray ? -1 : 0;
+      const float* r = rays + 8 * (i < nray ? i : base);
+      ray.org_x[k] = r[0]; ray.org_y[k] = r[1]; ray.org_z[k] = r[2]; ray.tnear[k] = r[3];
+      ray.dir_x[k] = r[4]; ray.dir_y[k] = r[5]; ray.dir_z[k] = r[6]; ray.tfar[k] = r[7];
+      ray.time[k] = 0; ray.mask[k] = 0xFFFFFFFF; ray.id[k] = 0; ray.flags[k] = 0;
+    }
+    rtcInitIntersectContext(&ctx);
+    rtcOccluded16(valid, scene, &ctx, &ray);
+    for (int k = 0; k < 16 && base + k < nray; k++) occ += ray.tfar[k] == -INFINITY;
+  }
+  return occ;
+}
+
+// Closest hits through rtcIntersect1M, STREAM rays per call (incoherent context).
+static size_t closest_streams(RTCScene scene, const float* rays, size_t nray, std::vector<float>& hits,
+                              std::vector<RTCRayHit>& buf) {
+  size_t hit_count = 0;
+  RTCIntersectContext ctx;
+  for (size_t base = 0; base < nray; base += STREAM) {
+    size_t m = std::min(STREAM, nray - base);
+    for (size_t k = 0; k < m; k++) {
+      load_ray(rays + 8 * (base + k), buf[k].ray);
+      buf[k].hit.geomID = RTC_INVALID_GEOMETRY_ID; buf[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcInitIntersectContext(&ctx);
+    rtcIntersect1M(scene, &ctx, buf.data(), (unsigned)m, sizeof(RTCRayHit));
+    for (size_t k = 0; k < m; k++) {
+      bool hit = buf[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      hits[base + k] = hit ? buf[k].ray.tfar : INFINITY;
+      hit_count += hit;
+    }
+  }
+  return hit_count;
+}
+
+static size_t occluded_streams(RTCScene scene, const float* rays, size_t nray, std::vector<RTCRay>& buf) {
+  size_t occ = 0;
+  RTCIntersectContext ctx;
+  for (size_t base = 0; base < nray; base += STREAM) {
+    size_t m = std::min(STREAM, nray - base);
+    for (size_t k = 0; k < m; k++) load_ray(rays + 8 * (base + k), buf[k]);
+    rtcInitIntersectContext(&ctx);
+    rtcOccluded1M(scene, &ctx, buf.data(), (unsigned)m, sizeof(RTCRay));
+    for (size_t k = 0; k < m; k++) occ += buf[k].tfar == -INFINITY;
+  }
+  return occ;
+}
+
+// Fraction of rays on which two hit lists agree (both miss, or the same distance to 1e-4).
+static double same_hits(const std::vector<float>& a, const std::vector<float>& b) {
+  size_t same = 0;
+  for (size_t i = 0; i < a.size(); i++) {
+    if (std::isinf(a[i]) && std::isinf(b[i])) same++;
+    else if (!std::isinf(a[i]) && !std::isinf(b[i]) &&
+             std::fabs(a[i] - b[i]) <= 1e-4f * std::max({std::fabs(a[i]), std::fabs(b[i]), 1e-6f})) same++;
+  }
+  return a.empty() ? 1.0 : (double)same / a.size();
+}
+
 int main(int argc, char** argv) {
+  _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+  _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+  if (argc == 2 && !strcmp(argv[1], "--isa")) {
+    RTCDevice dev = rtcNewDevice("threads=1,verbose=1");
+    rtcReleaseDevice(dev);
+    return 0;
+  }
   if (argc < 3) { fprintf(stderr, "usage: embree_bench TRIS.bin RAYS.bin [--hits OUT.bin] [--repeat N] [--quality high|medium] [--robust]\n"); return 2; }
   const char* hits_path = nullptr;
   int repeat = 5;
@@ -221,6 +339,25 @@ int main(int argc, char** argv) {
     }
     occluded_s = std::min(occluded_s, now() - t0);
   }
+  std::vector<float> packet_hits(nray), stream_hits(nray);
+  std::vector<RTCRayHit> stream_rayhits(STREAM);
+  std::vector<RTCRay> stream_rays(STREAM);
+  double closest16_s = INFINITY, occluded16_s = INFINITY, closest_m_s = INFINITY, occluded_m_s = INFINITY;
+  size_t occ16 = 0, occ_m = 0;
+  for (int rep = 0; rep < repeat; rep++) {
+    double t0 = now();
+    closest_packets(scene, rays, nray, packet_hits);
+    closest16_s = std::min(closest16_s, now() - t0);
+    t0 = now();
+    occ16 = occluded_packets(scene, rays, nray);
+    occluded16_s = std::min(occluded16_s, now() - t0);
+    t0 = now();
+    closest_streams(scene, rays, nray, stream_hits, stream_rayhits);
+    closest_m_s = std::min(closest_m_s, now() - t0);
+    t0 = now();
+    occ_m = occluded_streams(scene, rays, nray, stream_rays);
+    occluded_m_s = std::min(occluded_m_s, now() - t0);
+  }
   if (hits_path) {
     FILE* f = fopen(hits_path, "wb");
     fwrite(hits.data(), 4, nray, f);
@@ -232,11 +369,17 @@ int main(int argc, char** argv) {
   printf("{\"engine\":\"embree %d.%d.%d\",\"triangles\":%zu,\"rays\":%zu,\"threads\":1,\"build_ms\":%.3f,"
          "\"closest_mrays_per_s\":%.4f,\"occluded_mrays_per_s\":%.4f,\"hit_fraction\":%.6f,"
          "\"occluded_fraction\":%.6f,\"bvh_bytes\":%lld,\"bytes_per_triangle\":%.2f,"
-         "\"sah_cost\":%.4f,\"sah_cost_spatial\":%s}\n",
+         "\"sah_cost\":%.4f,\"sah_cost_spatial\":%s,"
+         "\"closest16_mrays_per_s\":%.4f,\"occluded16_mrays_per_s\":%.4f,"
+         "\"closest_stream_mrays_per_s\":%.4f,\"occluded_stream_mrays_per_s\":%.4f,"
+         "\"packet_agreement\":%.6f,\"stream_agreement\":%.6f,\"packet_occluded_same\":%s}\n",
          RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH, ntri, nray, build_s * 1e3,
          nray / closest_s / 1e6, nray / occluded_s / 1e6, (double)hit_count / nray, (double)occ_count / nray,
          bytes, (double)bytes / ntri, sah_binned,
-         std::isnan(sah_spatial) ? "null" : std::to_string(sah_spatial).c_str());
+         std::isnan(sah_spatial) ? "null" : std::to_string(sah_spatial).c_str(),
+         nray / closest16_s / 1e6, nray / occluded16_s / 1e6, nray / closest_m_s / 1e6, nray / occluded_m_s / 1e6,
+         same_hits(hits, packet_hits), same_hits(hits, stream_hits),
+         occ16 == occ_count && occ_m == occ_count ? "true" : "false");
   rtcReleaseScene(scene);
   rtcReleaseDevice(dev);
   return 0;
