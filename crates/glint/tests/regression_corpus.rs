@@ -53,8 +53,22 @@ fn load(format: &str, data: &[u8], path: &Path) -> Result<(), String> {
         "exr" => image_io::read_exr_bytes(data, path).map(drop),
         "pfm" => image_io::read_pfm_bytes(data, path).map(drop),
         "png" => image_io::decode_raster_bytes(data, path).map(drop),
+        "mitsuba" => mitsuba_scene(data, path),
         other => panic!("unknown corpus folder '{other}'"),
     }
+}
+
+/// A `mitsuba_scene` fuzz input: the scene, then the files it may include (`/fuzz/inc1.xml`,
+/// ...), separated by NUL bytes, read as that fuzz target reads them.
+fn mitsuba_scene(data: &[u8], path: &Path) -> Result<(), String> {
+    let mut parts = data.split(|&b| b == 0);
+    let scene = String::from_utf8_lossy(parts.next().unwrap_or_default()).into_owned();
+    let files: std::collections::HashMap<PathBuf, String> = parts
+        .take(7)
+        .enumerate()
+        .map(|(i, p)| (PathBuf::from(format!("/fuzz/inc{}.xml", i + 1)), String::from_utf8_lossy(p).into_owned()))
+        .collect();
+    glint::formats::mitsuba::read_str_with_includes(&scene, path, &[], &files).map(drop).map_err(|e| e.to_string())
 }
 
 /// Runs one case on its own thread: Some(result), or None if it panicked or timed out.

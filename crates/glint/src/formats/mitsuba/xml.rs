@@ -87,8 +87,9 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
         let ev = reader
             .read_event()
             .map_err(|e| Error::at(&loc_at(reader.error_position() as usize), format!("malformed XML: {e}")))?;
-        // The event starts at the first '<' after the previous event.
-        let start = text[before..].find('<').map_or(before, |o| before + o);
+        // The event starts at the first '<' after the previous event. (Searched as bytes:
+        // the reader's position need not be a char boundary, e.g. inside a second BOM.)
+        let start = text.as_bytes().get(before..).and_then(|b| b.iter().position(|&c| c == b'<')).map_or(before, |o| before + o);
         let make = |e: &quick_xml::events::BytesStart| -> Result<Element, Error> {
             let tag = String::from_utf8_lossy(e.name().as_ref()).to_string();
             let mut attrs = Vec::new();
