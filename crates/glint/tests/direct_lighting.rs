@@ -156,7 +156,8 @@ fn sphere_lights_facing_the_point() {
     let le = 4.0f32;
     // The last is 1e-7 sr across: 1 - cos θmax cancels to nothing in f32 there (and BSDF
     // sampling all but never hits it, so it is checked with the strategies that sample lights).
-    let configs = [(0.5f32, 2.0f32, &AREA_STRATEGIES[..]), (0.8, 1.2, &AREA_STRATEGIES[..]), (0.01, 50.0, &DELTA_STRATEGIES[..])];
+    let configs =
+        [(0.5f32, 2.0f32, &AREA_STRATEGIES[..]), (0.8, 1.2, &AREA_STRATEGIES[..]), (0.01, 50.0, &DELTA_STRATEGIES[..])];
     let k = z_critical(FALSE_ALARM, configs.iter().map(|c| c.2.len()).sum());
     let mut failures = Vec::new();
     for (r, d, strategies) in configs {
@@ -184,7 +185,14 @@ fn rectangle_light_close_overhead() {
     let scene = finish(b);
     let e = polygon_irradiance(Vec3::ZERO, Vec3::Y, &corners, le as f64);
     let mut failures = Vec::new();
-    check("close rectangle", &scene, e, &AREA_STRATEGIES, &mut failures, z_critical(FALSE_ALARM, AREA_STRATEGIES.len()));
+    check(
+        "close rectangle",
+        &scene,
+        e,
+        &AREA_STRATEGIES,
+        &mut failures,
+        z_critical(FALSE_ALARM, AREA_STRATEGIES.len()),
+    );
     report(failures);
 }
 
@@ -224,10 +232,11 @@ fn hidden_emitters_are_looked_through() {
     b.add_light(Light::Point { position: light, intensity: Rgb::splat(intensity) });
     let scene = b.finish(camera(vec3(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 0.001, 4, 4), LightSelection::Power).unwrap();
     let to_light = light - vec3(0.0, 0.0, -2.0);
-    let wall_radiance =
-        ALBEDO as f64 / PI as f64 * intensity as f64 * (to_light.z / to_light.length()) as f64 / to_light.length_squared() as f64;
+    let wall_radiance = ALBEDO as f64 / PI as f64 * intensity as f64 * (to_light.z / to_light.length()) as f64
+        / to_light.length_squared() as f64;
     let direct = |hide_emitters| Integrator::Direct(DirectSettings { hide_emitters, ..DirectSettings::default() });
-    let path_tracer = |hide_emitters| Integrator::Path(glint::integrators::PathSettings { hide_emitters, ..Default::default() });
+    let path_tracer =
+        |hide_emitters| Integrator::Path(glint::integrators::PathSettings { hide_emitters, ..Default::default() });
     let cases = [
         ("direct, hidden", direct(true), wall_radiance),
         ("path, hidden", path_tracer(true), wall_radiance),
@@ -238,7 +247,12 @@ fn hidden_emitters_are_looked_through() {
     for (name, integrator, expected) in cases {
         // The only noise is which of the two lights is picked for the wall.
         let e = image_estimate(&render_with(&scene, &integrator, 1024, 1), 0);
-        assert!((e.mean - expected).abs() <= k * e.se + FLOAT_FLOOR * expected, "{name}: {} ± {} instead of {expected}", e.mean, e.se);
+        assert!(
+            (e.mean - expected).abs() <= k * e.se + FLOAT_FLOOR * expected,
+            "{name}: {} ± {} instead of {expected}",
+            e.mean,
+            e.se
+        );
     }
 }
 

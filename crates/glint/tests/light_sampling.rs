@@ -105,7 +105,13 @@ fn cases() -> Vec<Case> {
         sphere_case("sphere at 3 radii", vec3(0.3, 3.0, -0.2), 1.0, Vec3::ZERO),
         sphere_case("sphere filling 110 degrees", vec3(0.0, 0.0, 0.6), 0.5, Vec3::ZERO),
         sphere_case("small distant sphere", vec3(40.0, 10.0, 5.0), 0.2, vec3(0.1, 0.2, 0.3)),
-        rectangle_case("rectangle overhead", vec3(-1.0, 0.5, -0.7), vec3(2.0, 0.0, 0.0), vec3(0.0, 0.0, 1.4), Vec3::ZERO),
+        rectangle_case(
+            "rectangle overhead",
+            vec3(-1.0, 0.5, -0.7),
+            vec3(2.0, 0.0, 0.0),
+            vec3(0.0, 0.0, 1.4),
+            Vec3::ZERO,
+        ),
         rectangle_case(
             "oblique rectangle off to the side",
             vec3(0.4, 0.2, 0.9),
@@ -113,7 +119,13 @@ fn cases() -> Vec<Case> {
             vec3(0.0, 0.0, 0.7),
             vec3(-0.3, 0.1, 0.0),
         ),
-        rectangle_case("far rectangle (area sampling)", vec3(20.0, 0.0, 0.0), vec3(0.0, 0.1, 0.0), vec3(0.0, 0.0, 0.1), Vec3::ZERO),
+        rectangle_case(
+            "far rectangle (area sampling)",
+            vec3(20.0, 0.0, 0.0),
+            vec3(0.0, 0.1, 0.0),
+            vec3(0.0, 0.0, 0.1),
+            Vec3::ZERO,
+        ),
     ]
 }
 
@@ -215,7 +227,8 @@ fn light_samplers_draw_the_density_they_report() {
         }
         match outcome {
             Ok(o) if o.p_value >= alpha => {}
-            Ok(o) => failures.push(format!("{}: chi-square {:.1} on {} dof, p = {:.2e}", c.label, o.statistic, o.dof, o.p_value)),
+            Ok(o) => failures
+                .push(format!("{}: chi-square {:.1} on {} dof, p = {:.2e}", c.label, o.statistic, o.dof, o.p_value)),
             Err(e) => failures.push(format!("{}: {e}", c.label)),
         }
     }

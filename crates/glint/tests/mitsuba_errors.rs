@@ -84,7 +84,9 @@ fn defines_override_defaults_and_refs_resolve() {
 #[test]
 fn direct_integrator_sample_counts() {
     use glint::describe::{DirectSettings, IntegratorDesc};
-    let scene = |params: &str| format!("<scene version=\"3.0.0\">\n{SENSOR}\n<integrator type=\"direct\">{params}</integrator>\n</scene>\n");
+    let scene = |params: &str| {
+        format!("<scene version=\"3.0.0\">\n{SENSOR}\n<integrator type=\"direct\">{params}</integrator>\n</scene>\n")
+    };
     let read = |params: &str| {
         let desc = glint::formats::mitsuba::read_str(&scene(params), std::path::Path::new("direct.xml"), &[]).unwrap();
         match desc.integrator {
@@ -96,7 +98,10 @@ fn direct_integrator_sample_counts() {
     assert_eq!(counts(read("")), (1, 1));
     assert_eq!(counts(read(r#"<integer name="shading_samples" value="3"/>"#)), (3, 3));
     assert_eq!(counts(read(r#"<integer name="emitter_samples" value="0"/>"#)), (0, 1));
-    assert_eq!(counts(read(r#"<integer name="bsdf_samples" value="4"/><integer name="emitter_samples" value="2"/>"#)), (2, 4));
+    assert_eq!(
+        counts(read(r#"<integer name="bsdf_samples" value="4"/><integer name="emitter_samples" value="2"/>"#)),
+        (2, 4)
+    );
     assert!(read(r#"<boolean name="hide_emitters" value="true"/>"#).hide_emitters);
     for (params, needle) in [
         (r#"<integer name="shading_samples" value="2"/><integer name="bsdf_samples" value="1"/>"#, "not both"),

@@ -124,19 +124,7 @@ impl SphericalRectangle {
         if !(MIN_SOLID_ANGLE..=MAX_SOLID_ANGLE).contains(&solid_angle) {
             return None;
         }
-        Some(SphericalRectangle {
-            origin,
-            axes: [x, y, z],
-            x0,
-            x1,
-            y0,
-            y1,
-            z0,
-            b0: n0[2],
-            b1: n2[2],
-            k,
-            solid_angle,
-        })
+        Some(SphericalRectangle { origin, axes: [x, y, z], x0, x1, y0, y1, z0, b0: n0[2], b1: n2[2], k, solid_angle })
     }
 
     /// Density in solid angle of every direction towards the rectangle.
@@ -191,7 +179,12 @@ mod tests {
     use super::*;
 
     fn rect() -> Rectangle {
-        Rectangle { corner: vec3(-0.5, 1.0, -0.3), ex: vec3(1.0, 0.0, 0.0), ey: vec3(0.0, 0.2, 0.6), normal: Vec3::ZERO }
+        Rectangle {
+            corner: vec3(-0.5, 1.0, -0.3),
+            ex: vec3(1.0, 0.0, 0.0),
+            ey: vec3(0.0, 0.2, 0.6),
+            normal: Vec3::ZERO,
+        }
     }
 
     #[test]
@@ -228,7 +221,9 @@ mod tests {
         assert_eq!(r.normal, Vec3::Z);
         assert!(Rectangle::from_triangles(&[[a, b, c], [a, d, c]]).is_none(), "triangles facing apart");
         let skew = vec3(0.3, 1.0, 0.0);
-        assert!(Rectangle::from_triangles(&[[a, b, c + vec3(0.3, 0.0, 0.0)], [a, c + vec3(0.3, 0.0, 0.0), skew]]).is_none());
+        assert!(
+            Rectangle::from_triangles(&[[a, b, c + vec3(0.3, 0.0, 0.0)], [a, c + vec3(0.3, 0.0, 0.0), skew]]).is_none()
+        );
         assert!(Rectangle::from_triangles(&[[a, b, c]]).is_none());
     }
 }
