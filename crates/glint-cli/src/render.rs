@@ -7,7 +7,7 @@ use crate::commands::{CliError, RenderArgs, ResumeArgs, RunArgs};
 use crate::outputs::{output_files, temp_files, write_film_image};
 use crate::progress::ProgressBar;
 use crate::signals;
-use glint::describe::{IntegratorDesc, PathSettings, SceneDesc, WhittedSettings};
+use glint::describe::{DirectSettings, IntegratorDesc, PathSettings, SceneDesc, WhittedSettings};
 use glint::render::{Adaptive, Aov, Film};
 use glint::session::{FilmOptions, RenderControl, RenderReport, Session};
 use std::io::IsTerminal;
@@ -322,6 +322,9 @@ fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
         Some("path") if !matches!(d.integrator, IntegratorDesc::Path(_)) => {
             d.integrator = IntegratorDesc::Path(PathSettings::default())
         }
+        Some("direct") if !matches!(d.integrator, IntegratorDesc::Direct(_)) => {
+            d.integrator = IntegratorDesc::Direct(DirectSettings::default())
+        }
         _ => {}
     }
     match &mut d.integrator {
@@ -334,6 +337,14 @@ fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
                     );
                 }
                 w.max_depth = depth as u32;
+            }
+            if a.strategy.is_some() {
+                return Err("--strategy applies to the path integrator only".into());
+            }
+        }
+        IntegratorDesc::Direct(_) => {
+            if a.max_depth.is_some() {
+                return Err("--max-depth does not apply to the direct integrator (it stops at the first hit)".into());
             }
             if a.strategy.is_some() {
                 return Err("--strategy applies to the path integrator only".into());

@@ -99,6 +99,28 @@ fn thin_lens_and_glass() {
     check("thinlens");
 }
 
+#[test]
+fn spherical_area_lights() {
+    check("sphere-light");
+}
+
+/// Mitsuba's `direct` with 2 emitter and 3 BSDF samples per shading point.
+#[test]
+fn direct_integrator_with_both_strategies() {
+    check("direct-mis");
+}
+
+/// `direct` with BSDF samples only: no light sampling, so its error is that of BSDF sampling.
+#[test]
+fn direct_integrator_with_bsdf_samples_only() {
+    check("direct-bsdf");
+}
+
+#[test]
+fn direct_integrator_with_emitter_samples_only() {
+    check("direct-emitter");
+}
+
 /// Mitsuba's own Cornell box (`mitsuba.cornell_box()` as XML, gaussian reconstruction filter):
 /// per-channel means within 1% of Mitsuba's. Only the means: the two renderers reconstruct with
 /// a gaussian filter differently (glint samples the filter, Mitsuba splats), which changes the

@@ -77,3 +77,38 @@ fn defines_override_defaults_and_refs_resolve() {
     let e = error_of("badref.xml", &text.replace("<ref id=\"m\"/>", "<ref id=\"nope\"/>"));
     assert!(e.contains("badref.xml:8:") && e.contains("nope"), "{e}");
 }
+
+/// The `direct` integrator's counts as Mitsuba reads them: `shading_samples` sets both, each
+/// of `emitter_samples` and `bsdf_samples` overrides one; giving both kinds, a negative count,
+/// or no sample at all is an error.
+#[test]
+fn direct_integrator_sample_counts() {
+    use glint::describe::{DirectSettings, IntegratorDesc};
+    let scene = |params: &str| {
+        format!("<scene version=\"3.0.0\">\n{SENSOR}\n<integrator type=\"direct\">{params}</integrator>\n</scene>\n")
+    };
+    let read = |params: &str| {
+        let desc = glint::formats::mitsuba::read_str(&scene(params), std::path::Path::new("direct.xml"), &[]).unwrap();
+        match desc.integrator {
+            IntegratorDesc::Direct(d) => d,
+            other => panic!("{params}: read as {other:?}"),
+        }
+    };
+    let counts = |d: DirectSettings| (d.emitter_samples, d.bsdf_samples);
+    assert_eq!(counts(read("")), (1, 1));
+    assert_eq!(counts(read(r#"<integer name="shading_samples" value="3"/>"#)), (3, 3));
+    assert_eq!(counts(read(r#"<integer name="emitter_samples" value="0"/>"#)), (0, 1));
+    assert_eq!(
+        counts(read(r#"<integer name="bsdf_samples" value="4"/><integer name="emitter_samples" value="2"/>"#)),
+        (2, 4)
+    );
+    assert!(read(r#"<boolean name="hide_emitters" value="true"/>"#).hide_emitters);
+    for (params, needle) in [
+        (r#"<integer name="shading_samples" value="2"/><integer name="bsdf_samples" value="1"/>"#, "not both"),
+        (r#"<integer name="emitter_samples" value="-1"/>"#, "out of range"),
+        (r#"<integer name="emitter_samples" value="0"/><integer name="bsdf_samples" value="0"/>"#, "at least one"),
+    ] {
+        let e = error_of("direct.xml", &scene(params));
+        assert!(e.contains("direct.xml:4:") && e.contains(needle), "{params}: {e}");
+    }
+}

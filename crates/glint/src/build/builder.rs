@@ -11,7 +11,6 @@ use crate::lights::LightSelection;
 use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
 use crate::math::{Aabb, Rgb, Transform, Vec3};
-use crate::sampling::Distribution1d;
 use crate::world::{Instance, ShapeRef, World};
 use std::collections::HashMap;
 use std::path::Path;
@@ -208,19 +207,16 @@ impl WorldBuilder {
                 })
                 .map(|[a, b, c]| if flip_normals { [a, c, b] } else { [a, b, c] })
                 .collect();
-            let areas: Vec<f32> = triangles.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
-            let total_area = areas.iter().sum();
-            (triangles, areas, total_area, e)
+            (triangles, e)
         });
         let light = match light {
-            Some((triangles, areas, total_area, e)) => {
-                let Some(dist) = Distribution1d::new(&areas) else {
+            Some((triangles, e)) => {
+                let Some(emitter) = MeshEmitter::new(triangles) else {
                     return Err("an emitting mesh has zero area".into());
                 };
-                let emitter = Arc::new(MeshEmitter { triangles, areas: dist, total_area });
                 self.lights.push(PendingLight::Ready(Light::Mesh {
                     instance,
-                    emitter,
+                    emitter: Arc::new(emitter),
                     radiance: e.radiance,
                     two_sided: e.two_sided,
                 }));

@@ -9,7 +9,7 @@ use crate::error::{Error, SourceLoc};
 use crate::math::{Rgb, Vec3};
 use crate::sampling::PixelFilter;
 
-use crate::describe::limits::{check_resolution, MAX_SPP, MAX_WHITTED_DEPTH};
+use crate::describe::limits::{check_resolution, MAX_DIRECT_SAMPLES, MAX_SPP, MAX_WHITTED_DEPTH};
 
 pub fn check(d: &SceneDesc) -> Result<(), Error> {
     film(&d.film)?;
@@ -30,6 +30,19 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
                 ));
             }
             color(Rgb::from_array(w.background), "whitted: background").map_err(|m| Error::at(&origin, m))?;
+        }
+        IntegratorDesc::Direct(s) => {
+            for (n, what) in [(s.emitter_samples, "emitter_samples"), (s.bsdf_samples, "bsdf_samples")] {
+                if n > MAX_DIRECT_SAMPLES {
+                    return Err(Error::at(
+                        &origin,
+                        format!("direct: {what} {n} is out of range (0 to {MAX_DIRECT_SAMPLES})"),
+                    ));
+                }
+            }
+            if s.emitter_samples == 0 && s.bsdf_samples == 0 {
+                return Err(Error::at(&origin, "direct: emitter_samples and bsdf_samples are both 0"));
+            }
         }
         IntegratorDesc::Path(p) => {
             if let Some(q) = p.rr_probability {

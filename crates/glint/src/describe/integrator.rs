@@ -38,7 +38,8 @@ pub struct PathSettings {
     /// A fixed survival probability (the paper's P) instead of the throughput-based one.
     pub rr_probability: Option<f32>,
     pub strategy: Strategy,
-    /// Do not show emitters seen directly by the camera.
+    /// Look through emitters seen directly by the camera (as Mitsuba does: what lies behind
+    /// an area light shows instead), and leave the sky black.
     pub hide_emitters: bool,
 }
 
@@ -51,6 +52,23 @@ impl Default for PathSettings {
             strategy: Strategy::Mis,
             hide_emitters: false,
         }
+    }
+}
+
+/// Direct illumination only (Mitsuba's `direct`): at the first hit, `emitter_samples` light
+/// samples and `bsdf_samples` BSDF samples combined by MIS weighted by those counts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DirectSettings {
+    pub emitter_samples: u32,
+    pub bsdf_samples: u32,
+    /// Look through emitters seen directly by the camera, and leave the sky black.
+    pub hide_emitters: bool,
+}
+
+impl Default for DirectSettings {
+    fn default() -> Self {
+        DirectSettings { emitter_samples: 1, bsdf_samples: 1, hide_emitters: false }
     }
 }
 

@@ -8,6 +8,8 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 pub const MAX_SPP: u32 = 1 << 24;
 /// The deepest Whitted recursion (it is iterative: this bounds the work, not the stack).
 pub const MAX_WHITTED_DEPTH: u32 = 1 << 16;
+/// The most light or BSDF samples the direct integrator may take per camera sample.
+pub const MAX_DIRECT_SAMPLES: u32 = 1 << 12;
 
 /// Rejects zero and absurd resolutions.
 pub fn check_resolution(w: u32, h: u32) -> Result<(), String> {

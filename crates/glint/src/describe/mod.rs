@@ -19,7 +19,7 @@ use std::path::PathBuf;
 
 mod integrator;
 pub mod limits;
-pub use integrator::{PathSettings, Strategy, WhittedSettings};
+pub use integrator::{DirectSettings, PathSettings, Strategy, WhittedSettings};
 
 /// A 4x4 row-major object-to-world matrix (column vectors: `p' = M p`).
 pub type Matrix4 = [[f64; 4]; 4];
@@ -75,6 +75,7 @@ pub struct FilmDesc {
 pub enum IntegratorDesc {
     Whitted(WhittedSettings),
     Path(PathSettings),
+    Direct(DirectSettings),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

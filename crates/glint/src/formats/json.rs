@@ -8,9 +8,9 @@ use super::json_spans::Spans;
 use crate::bsdf::MicrofacetKind;
 use crate::camera::FovAxis;
 use crate::describe::{
-    CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
-    MaterialRef, Matrix4, MeshFileDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, Strategy,
-    TextureDesc, WhittedSettings,
+    CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
+    MaterialModel, MaterialRef, Matrix4, MeshFileDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc,
+    Strategy, TextureDesc, WhittedSettings,
 };
 use crate::error::{Error, SourceLoc};
 use crate::lights::LightSelection;
@@ -87,6 +87,16 @@ enum JsonIntegrator {
         rr_probability: Option<f32>,
         #[serde(default)]
         strategy: Option<Strategy>,
+        #[serde(default)]
+        light_selection: Option<String>,
+        #[serde(default)]
+        hide_emitters: bool,
+    },
+    Direct {
+        #[serde(default)]
+        emitter_samples: Option<u64>,
+        #[serde(default)]
+        bsdf_samples: Option<u64>,
         #[serde(default)]
         light_selection: Option<String>,
         #[serde(default)]
@@ -523,6 +533,24 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
                 },
                 rr_probability: *rr_probability,
                 strategy: strategy.unwrap_or(Strategy::Mis),
+                hide_emitters: *hide_emitters,
+            })
+        }
+        Some(JsonIntegrator::Direct { emitter_samples, bsdf_samples, light_selection, hide_emitters }) => {
+            if let Some(ls) = light_selection {
+                desc.light_selection =
+                    ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
+            }
+            let max = crate::describe::limits::MAX_DIRECT_SAMPLES as u64;
+            let count = |v: &Option<u64>, name: &str| -> Result<u32, Error> {
+                match v {
+                    Some(n) => narrow(&ctx, &format!("integrator/{name}"), name, *n, 0, max),
+                    None => Ok(1),
+                }
+            };
+            IntegratorDesc::Direct(DirectSettings {
+                emitter_samples: count(emitter_samples, "emitter_samples")?,
+                bsdf_samples: count(bsdf_samples, "bsdf_samples")?,
                 hide_emitters: *hide_emitters,
             })
         }

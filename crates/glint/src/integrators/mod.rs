@@ -3,17 +3,18 @@
 //! Each integrator has serialisable settings and a per-ray `li`; scheduling of pixels and
 //! threads lives in the render module, so integrators never see threads.
 
+mod direct;
 mod first_hit;
 mod path;
 mod whitted;
 
-pub use crate::describe::{PathSettings, Strategy, WhittedSettings};
+pub use crate::describe::{DirectSettings, PathSettings, Strategy, WhittedSettings};
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 
 use crate::bsdf::Bsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::sampling::Sampler;
-use crate::world::{SurfaceInteraction, World};
+use crate::world::{Hit, SurfaceInteraction, World};
 
 /// Per-thread counters, summed at the end of a render.
 #[derive(Clone, Copy, Debug, Default)]
@@ -26,6 +27,7 @@ pub struct Counters {
 pub enum Integrator {
     Whitted(WhittedSettings),
     Path(PathSettings),
+    Direct(DirectSettings),
 }
 
 impl From<&crate::describe::IntegratorDesc> for Integrator {
@@ -33,6 +35,7 @@ impl From<&crate::describe::IntegratorDesc> for Integrator {
         match d {
             crate::describe::IntegratorDesc::Whitted(w) => Integrator::Whitted(w.clone()),
             crate::describe::IntegratorDesc::Path(p) => Integrator::Path(p.clone()),
+            crate::describe::IntegratorDesc::Direct(s) => Integrator::Direct(s.clone()),
         }
     }
 }
@@ -42,6 +45,7 @@ impl Integrator {
         match self {
             Integrator::Whitted(_) => "whitted",
             Integrator::Path(_) => "path",
+            Integrator::Direct(_) => "direct",
         }
     }
 
@@ -50,6 +54,7 @@ impl Integrator {
         match self {
             Integrator::Whitted(s) => whitted::li(s, scene, ray, rng, counters),
             Integrator::Path(s) => path::li(s, scene, ray, rng, counters),
+            Integrator::Direct(s) => direct::li(s, scene, ray, rng, counters),
         }
     }
 }
@@ -65,6 +70,27 @@ pub(crate) fn shading(scene: &World, si: &SurfaceInteraction, wo_world: Vec3) ->
         frame = Frame { s: frame.s, t: -frame.t, n: -frame.n };
     }
     (bsdf, frame)
+}
+
+/// The most emitters a camera ray looks through when they are hidden; one that meets more
+/// (a stack of coincident lights) ends there as if it had left the scene.
+const MAX_HIDDEN_EMITTERS: u32 = 64;
+
+/// The first hit of a camera ray, and the ray that made it. With `hide_emitters` the ray
+/// passes through every emitter it meets, as Mitsuba's `hide_emitters` does, so that what lies
+/// behind an area light shows instead of it.
+pub(crate) fn camera_hit(scene: &World, ray: &Ray, hide_emitters: bool, c: &mut Counters) -> Option<(Ray, Hit)> {
+    let mut ray = *ray;
+    for _ in 0..=MAX_HIDDEN_EMITTERS {
+        c.rays += 1;
+        let hit = scene.intersect(&ray)?;
+        let si = scene.interaction(&ray, &hit);
+        if !hide_emitters || si.light.is_none() {
+            return Some((ray, hit));
+        }
+        ray = spawn_ray(&si, ray.dir);
+    }
+    None
 }
 
 /// A ray leaving the surface at `si` in direction `dir`, offset off the surface.

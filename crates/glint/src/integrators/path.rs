@@ -3,7 +3,7 @@
 //! by default. Depth counts path segments, as Mitsuba's `max_depth` does: 1 shows emitters
 //! seen directly, 2 adds direct lighting, and so on.
 
-use super::{shading, shadow_ray, spawn_ray, Counters};
+use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
 
 /// The longest path, in segments, even when `max_depth` is unbounded: a hard ceiling so that
@@ -34,8 +34,16 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
     let mut depth = 0u32; // segments traced so far
 
     loop {
-        c.rays += 1;
-        let hit = scene.intersect(&ray);
+        let hit = if depth == 0 {
+            // Hidden emitters are looked through by the camera ray (and not counted as depth).
+            camera_hit(scene, &ray, s.hide_emitters, c).map(|(r, h)| {
+                ray = r;
+                h
+            })
+        } else {
+            c.rays += 1;
+            scene.intersect(&ray)
+        };
         depth += 1;
         let Some(hit) = hit else {
             if !(depth == 1 && s.hide_emitters) {

@@ -9,9 +9,14 @@
 //! hit by BSDF-sampled rays.
 
 mod envmap;
+mod rectangle;
 mod selection;
+mod sphere;
 pub use envmap::EnvMap;
+pub use rectangle::Rectangle;
 pub use selection::LightSelection;
+
+use rectangle::SphericalRectangle;
 
 use crate::geometry::Sphere;
 use crate::math::{Aabb, Frame, Rgb, Vec3, PI};
@@ -33,12 +38,30 @@ pub struct LightSample {
 
 /// A triangle-mesh emitter, with its triangles in world space and a distribution
 /// proportional to their area (the paper's choice: pick a triangle by area, then a uniform
-/// point on it).
+/// point on it). A mesh that is one rectangle is sampled by solid angle instead, from the
+/// points where that works (see `rectangle`).
 #[derive(Clone, Debug)]
 pub struct MeshEmitter {
     pub triangles: Vec<[Vec3; 3]>,
     pub areas: Distribution1d,
     pub total_area: f32,
+    pub rectangle: Option<Rectangle>,
+}
+
+impl MeshEmitter {
+    /// `None` when the triangles have no area.
+    pub fn new(triangles: Vec<[Vec3; 3]>) -> Option<MeshEmitter> {
+        let areas: Vec<f32> = triangles.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
+        let total_area = areas.iter().sum();
+        let areas = Distribution1d::new(&areas)?;
+        let rectangle = Rectangle::from_triangles(&triangles);
+        Some(MeshEmitter { triangles, areas, total_area, rectangle })
+    }
+
+    /// The solid-angle parametrization to sample from `p`, where it applies.
+    fn spherical_rectangle(&self, p: Vec3) -> Option<SphericalRectangle> {
+        self.rectangle.as_ref().and_then(|r| SphericalRectangle::new(r, p))
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -154,11 +177,16 @@ impl Light {
                 Some(LightSample { wi: -*direction, radiance: *irradiance, pdf: 1.0, dist: f32::INFINITY, delta: true })
             }
             Light::Mesh { emitter, radiance, two_sided, .. } => {
-                let pick = emitter.areas.sample(u[0]);
-                let [a, b, c] = emitter.triangles[pick.index];
-                let bary = warp::uniform_triangle([pick.remapped, u[1]]);
-                let q = a * (1.0 - bary[0] - bary[1]) + b * bary[0] + c * bary[1];
-                let n = (b - a).cross(c - a).normalize();
+                let by_solid_angle = emitter.spherical_rectangle(p);
+                let (q, n) = match &by_solid_angle {
+                    Some(sr) => (sr.sample(u), emitter.rectangle.as_ref()?.normal),
+                    None => {
+                        let pick = emitter.areas.sample(u[0]);
+                        let [a, b, c] = emitter.triangles[pick.index];
+                        let bary = warp::uniform_triangle([pick.remapped, u[1]]);
+                        (a * (1.0 - bary[0] - bary[1]) + b * bary[0] + c * bary[1], (b - a).cross(c - a).normalize())
+                    }
+                };
                 let d = q - p;
                 let dist2 = d.length_squared();
                 if dist2 == 0.0 {
@@ -170,10 +198,13 @@ impl Light {
                 if cos_l == 0.0 || (!two_sided && cos_l < 0.0) {
                     return None;
                 }
-                let pdf = dist2 / (cos_l.abs() * emitter.total_area);
+                let pdf = match &by_solid_angle {
+                    Some(sr) => sr.pdf(),
+                    None => dist2 / (cos_l.abs() * emitter.total_area),
+                };
                 Some(LightSample { wi, radiance: *radiance, pdf, dist, delta: false })
             }
-            Light::Sphere { sphere, radiance, inward, .. } => sample_sphere(sphere, *radiance, *inward, p, u),
+            Light::Sphere { sphere, radiance, inward, .. } => sphere::sample(sphere, *radiance, *inward, p, u),
             Light::Constant { radiance, .. } => {
                 let wi = warp::uniform_sphere(u);
                 Some(LightSample {
@@ -193,6 +224,9 @@ impl Light {
     pub fn pdf_li(&self, p: Vec3, wi: Vec3, q: Vec3, n: Vec3) -> f32 {
         match self {
             Light::Mesh { emitter, .. } => {
+                if let Some(sr) = emitter.spherical_rectangle(p) {
+                    return sr.pdf();
+                }
                 let dist2 = (q - p).length_squared();
                 let cos_l = n.dot(wi).abs();
                 if cos_l == 0.0 {
@@ -200,7 +234,7 @@ impl Light {
                 }
                 dist2 / (cos_l * emitter.total_area)
             }
-            Light::Sphere { sphere, .. } => pdf_sphere(sphere, p, q, n, wi),
+            Light::Sphere { sphere, .. } => sphere::pdf(sphere, p, q, n, wi),
             Light::Constant { .. } => warp::UNIFORM_SPHERE_PDF,
             Light::EnvMap(env) => env.pdf(wi),
             _ => 0.0,
@@ -247,61 +281,6 @@ fn spot_falloff(cos_t: f32, cutoff: f32, beam: f32) -> f32 {
         return 1.0;
     }
     ((cutoff - cos_t.clamp(-1.0, 1.0).acos()) / (cutoff - beam)).clamp(0.0, 1.0)
-}
-
-/// Cone sampling of a sphere seen from outside (pbrt's approach), uniform area from inside.
-/// A sphere emits on one side only: nothing reaches `p` from the other.
-fn sample_sphere(s: &Sphere, radiance: Rgb, inward: bool, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
-    let to_c = s.center - p;
-    let dc2 = to_c.length_squared();
-    let r2 = s.radius * s.radius;
-    let inside = dc2 <= r2 * 1.0001;
-    if inside != inward {
-        return None;
-    }
-    if inside {
-        // Inside (or on) the sphere: sample its area uniformly.
-        let n = warp::uniform_sphere(u);
-        let q = s.center + n * s.radius;
-        let d = q - p;
-        let dist2 = d.length_squared();
-        if dist2 == 0.0 {
-            return None;
-        }
-        let dist = dist2.sqrt();
-        let wi = d / dist;
-        let cos_l = n.dot(wi).abs();
-        if cos_l == 0.0 {
-            return None;
-        }
-        return Some(LightSample { wi, radiance, pdf: dist2 / (cos_l * s.area()), dist, delta: false });
-    }
-    let dc = dc2.sqrt();
-    let sin_max2 = r2 / dc2;
-    let cos_max = (1.0 - sin_max2).max(0.0).sqrt();
-    let frame = Frame::from_normal(to_c / dc);
-    let local = warp::uniform_cone(u, cos_max);
-    let wi = frame.to_world(local).normalize();
-    // Distance to the near intersection along wi.
-    let b = to_c.dot(wi);
-    let disc = (r2 - (dc2 - b * b)).max(0.0);
-    let dist = b - disc.sqrt();
-    Some(LightSample { wi, radiance, pdf: warp::uniform_cone_pdf(cos_max), dist, delta: false })
-}
-
-fn pdf_sphere(s: &Sphere, p: Vec3, q: Vec3, n: Vec3, wi: Vec3) -> f32 {
-    let dc2 = (s.center - p).length_squared();
-    let r2 = s.radius * s.radius;
-    if dc2 <= r2 * 1.0001 {
-        let dist2 = (q - p).length_squared();
-        let cos_l = n.dot(wi).abs();
-        if cos_l == 0.0 {
-            return 0.0;
-        }
-        return dist2 / (cos_l * s.area());
-    }
-    let cos_max = (1.0 - r2 / dc2).max(0.0).sqrt();
-    warp::uniform_cone_pdf(cos_max)
 }
 
 /// Radius of a sphere that bounds the scene, for infinite lights' power estimates.

@@ -532,6 +532,9 @@ impl<'a> Reader<'a> {
             }
             Ok(d as u32)
         };
+        if ty == "direct" {
+            return self.direct_integrator(el, &p);
+        }
         let settings = match ty {
             "path" => PathSettings {
                 max_depth: depth(&p, -1)?,
@@ -539,15 +542,6 @@ impl<'a> Reader<'a> {
                 hide_emitters: p.bool("hide_emitters", false)?,
                 ..Default::default()
             },
-            "direct" => {
-                let _ = p.int("emitter_samples", 1)?;
-                let _ = p.int("bsdf_samples", 1)?;
-                PathSettings {
-                    max_depth: Some(2),
-                    hide_emitters: p.bool("hide_emitters", false)?,
-                    ..Default::default()
-                }
-            }
             other => {
                 self.warnings
                     .push(el.err(format!("integrator '{other}' is not supported; using 'path' instead")).to_string());
@@ -559,9 +553,37 @@ impl<'a> Reader<'a> {
                 }
             }
         };
-        if ty == "path" || ty == "direct" {
+        if ty == "path" {
             self.warn_unused(&p);
         }
         Ok(IntegratorDesc::Path(settings))
+    }
+
+    /// Mitsuba's `direct`: `shading_samples` (default 1) sets both counts unless
+    /// `emitter_samples` or `bsdf_samples` is given (giving both kinds is an error there too).
+    fn direct_integrator(&mut self, el: &'a Element, p: &Props<'a>) -> Result<IntegratorDesc, Error> {
+        let max = crate::describe::limits::MAX_DIRECT_SAMPLES;
+        let count = |name: &str, default: u32| -> Result<u32, Error> {
+            let v = p.int(name, default as i64)?;
+            if !(0..=max as i64).contains(&v) {
+                return Err(el.err(format!("{name} {v} is out of range (0 to {max})")));
+            }
+            Ok(v as u32)
+        };
+        let split = p.find("emitter_samples").is_some() || p.find("bsdf_samples").is_some();
+        if split && p.find("shading_samples").is_some() {
+            return Err(el.err("give either shading_samples or emitter_samples/bsdf_samples, not both"));
+        }
+        let shading = count("shading_samples", 1)?;
+        let settings = crate::describe::DirectSettings {
+            emitter_samples: count("emitter_samples", shading)?,
+            bsdf_samples: count("bsdf_samples", shading)?,
+            hide_emitters: p.bool("hide_emitters", false)?,
+        };
+        if settings.emitter_samples == 0 && settings.bsdf_samples == 0 {
+            return Err(el.err("direct needs at least one emitter or BSDF sample"));
+        }
+        self.warn_unused(p);
+        Ok(IntegratorDesc::Direct(settings))
     }
 }

@@ -1,0 +1,112 @@
+//! Direct illumination only, as Mitsuba 3's `direct` integrator: emitters seen along the
+//! camera ray, plus at its first hit `emitter_samples` light samples and `bsdf_samples` BSDF
+//! samples, combined by the power heuristic with the sample counts (Veach's multi-sample
+//! form: a strategy's density is weighted by how many samples it takes). A strategy given no
+//! samples gets weight zero, so 0 light samples is pure BSDF sampling and 0 BSDF samples pure
+//! light sampling.
+//!
+//! One deliberate difference: Mitsuba 3.9.1 gives each of its `emitter_samples` samples of a
+//! delta light (point, spot, directional) the weight 1 instead of 1/emitter_samples, so such
+//! lights come out emitter_samples times too bright there; here every light sample counts
+//! 1/emitter_samples.
+
+use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
+use crate::describe::DirectSettings;
+use crate::math::{Ray, Rgb};
+use crate::sampling::{power_heuristic, Sampler};
+use crate::world::World;
+
+pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
+    let Some((ray, hit)) = camera_hit(scene, camera_ray, s.hide_emitters, c) else {
+        if s.hide_emitters {
+            return Rgb::BLACK;
+        }
+        return scene
+            .environment_lights
+            .iter()
+            .fold(Rgb::BLACK, |l, &i| l + scene.lights[i as usize].environment(camera_ray.dir));
+    };
+    let si = scene.interaction(&ray, &hit);
+    let mut l = Rgb::BLACK;
+    if let Some(li_idx) = si.light {
+        // Only reached when emitters are shown (`camera_hit` looks through them otherwise).
+        l += scene.lights[li_idx as usize].emitted(si.ng, ray.dir);
+    }
+    let wo_world = -ray.dir;
+    let (bsdf, frame) = shading(scene, &si, wo_world);
+    let wo = frame.to_local(wo_world);
+    let (n_e, n_b) = (s.emitter_samples as f32, s.bsdf_samples as f32);
+
+    // Light sampling (not for BSDFs that only reflect in delta directions).
+    if !bsdf.is_delta() {
+        if let Some(dist) = &scene.light_distribution {
+            for _ in 0..s.emitter_samples {
+                let pick = dist.sample(rng.next_f32());
+                let light = &scene.lights[pick.index];
+                let Some(ls) = light.sample_li(si.p, rng.next_2d()) else {
+                    continue;
+                };
+                if !(ls.pdf > 0.0) || ls.radiance.is_black() {
+                    continue;
+                }
+                let wi = frame.to_local(ls.wi);
+                let f = bsdf.eval(wo, wi);
+                if f.is_black() {
+                    continue;
+                }
+                c.shadow_rays += 1;
+                if scene.occluded(&shadow_ray(&si, ls.wi, ls.dist)) {
+                    continue;
+                }
+                let light_pdf = pick.pmf * ls.pdf;
+                let w = if ls.delta { 1.0 } else { power_heuristic(n_e * light_pdf, n_b * bsdf.pdf(wo, wi)) };
+                l += f * ls.radiance * (w / (n_e * light_pdf));
+            }
+        }
+    }
+
+    // BSDF sampling: the emitter (or sky) each sampled ray reaches.
+    for _ in 0..s.bsdf_samples {
+        let u_lobe = rng.next_f32();
+        let Some(bs) = bsdf.sample(wo, u_lobe, rng.next_2d()) else {
+            continue;
+        };
+        if bs.weight.is_black() {
+            continue;
+        }
+        let wi_world = frame.to_world(bs.wi);
+        let ray = spawn_ray(&si, wi_world);
+        c.rays += 1;
+        // The weight of a light reached with light density `light_pdf` (zero after a delta
+        // sample, which light sampling cannot produce).
+        let weight = |light_pdf: f32| {
+            let w = if bs.delta { 1.0 } else { power_heuristic(n_b * bs.pdf, n_e * light_pdf) };
+            bs.weight * (w / n_b)
+        };
+        match scene.intersect(&ray) {
+            Some(hit) => {
+                let sj = scene.interaction(&ray, &hit);
+                let Some(li_idx) = sj.light else { continue };
+                let light = &scene.lights[li_idx as usize];
+                let le = light.emitted(sj.ng, ray.dir);
+                if le.is_black() {
+                    continue;
+                }
+                let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, sj.p, sj.ng);
+                l += weight(light_pdf) * le;
+            }
+            None => {
+                for &li_idx in &scene.environment_lights {
+                    let light = &scene.lights[li_idx as usize];
+                    let le = light.environment(ray.dir);
+                    if le.is_black() {
+                        continue;
+                    }
+                    let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, ray.origin, ray.dir);
+                    l += weight(light_pdf) * le;
+                }
+            }
+        }
+    }
+    l
+}

@@ -1,0 +1,236 @@
+//! Light samplers against their own densities. For a light seen from a point, directions
+//! are binned on the plane tangent to the direction of the light (a grid that is not the
+//! sampler's own parametrization), and the counts are compared by a chi-square test with
+//! the density `pdf_li` integrated over each bin by quadrature. That checks, at once, that
+//! the sampler draws the density it reports, that the density integrates to one over the
+//! directions that meet the light, and (each sample's `pdf` against `pdf_li` for the same
+//! direction) that a BSDF-sampled direction is given the density the light sampler would
+//! have given it, which multiple importance sampling relies on.
+//!
+//! Cases: spheres seen from outside (cone sampling), near and far; rectangles near enough
+//! to be sampled by solid angle, and one so far that it falls back to area sampling.
+
+mod common;
+
+use common::bsdf_check::chi2_test;
+use common::stats::{sidak, FALSE_ALARM};
+use glint::geometry::Sphere;
+use glint::lights::{Light, MeshEmitter};
+use glint::math::{vec3, Frame, Ray, Rgb, Vec3};
+use glint::sampling::Rng;
+use std::sync::Arc;
+
+const SAMPLES: u64 = 200_000;
+const BINS: usize = 12;
+/// Quadrature: each bin is split into SUB² cells, and cells that the light's silhouette
+/// crosses are split further, REFINE times (a cell split 2^REFINE ways a side).
+const SUB: usize = 12;
+const REFINE: u32 = 5;
+
+/// What a direction from the reference point meets on the light: point and normal.
+type Hit = Box<dyn Fn(Vec3, Vec3) -> Option<(Vec3, Vec3)>>;
+
+struct Case {
+    label: &'static str,
+    light: Light,
+    p: Vec3,
+    /// Towards the light's centre: the tangent plane's normal.
+    axis: Vec3,
+    /// Half-width of the grid on the tangent plane (covers the whole light).
+    extent: f32,
+    hit: Hit,
+}
+
+fn sphere_case(label: &'static str, center: Vec3, radius: f32, p: Vec3) -> Case {
+    let s = Sphere { center, radius };
+    let d = (center - p).length();
+    let hit: Hit = Box::new(move |o, w| {
+        let t = s.intersect(&Ray::new(o, w))?;
+        let q = o + w * t;
+        Some((q, (q - center).normalize()))
+    });
+    Case {
+        label,
+        light: Light::Sphere { instance: 0, sphere: s, radiance: Rgb::WHITE, inward: false },
+        p,
+        axis: (center - p).normalize(),
+        extent: 1.02 * radius / (d * d - radius * radius).sqrt(),
+        hit,
+    }
+}
+
+/// A rectangle `corner + s ex + t ey` (ex ⟂ ey) emitting towards `p`.
+fn rectangle_case(label: &'static str, corner: Vec3, ex: Vec3, ey: Vec3, p: Vec3) -> Case {
+    let (c1, c2, c3) = (corner + ex, corner + ex + ey, corner + ey);
+    let mut n = ex.cross(ey).normalize();
+    let mut tris = [[corner, c1, c2], [corner, c2, c3]];
+    if n.dot(p - corner) < 0.0 {
+        tris = [[corner, c2, c1], [corner, c3, c2]];
+        n = -n;
+    }
+    let emitter = MeshEmitter::new(tris.to_vec()).unwrap();
+    assert!(emitter.rectangle.is_some(), "{label}: not detected as a rectangle");
+    let center = corner + (ex + ey) * 0.5;
+    let axis = (center - p).normalize();
+    let frame = Frame::from_normal(axis);
+    let extent = [corner, c1, c2, c3]
+        .iter()
+        .map(|&c| {
+            let l = frame.to_local(c - p);
+            (l.x / l.z).abs().max((l.y / l.z).abs())
+        })
+        .fold(0.0f32, f32::max)
+        * 1.02;
+    let hit: Hit = Box::new(move |o, w| {
+        let t = (corner - o).dot(n) / w.dot(n);
+        if !(t > 0.0) {
+            return None;
+        }
+        let q = o + w * t;
+        let (s, r) = ((q - corner).dot(ex) / ex.length_squared(), (q - corner).dot(ey) / ey.length_squared());
+        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some((q, n))
+    });
+    Case {
+        label,
+        light: Light::Mesh { instance: 0, emitter: Arc::new(emitter), radiance: Rgb::WHITE, two_sided: false },
+        p,
+        axis,
+        extent,
+        hit,
+    }
+}
+
+fn cases() -> Vec<Case> {
+    vec![
+        sphere_case("sphere at 3 radii", vec3(0.3, 3.0, -0.2), 1.0, Vec3::ZERO),
+        sphere_case("sphere filling 110 degrees", vec3(0.0, 0.0, 0.6), 0.5, Vec3::ZERO),
+        sphere_case("small distant sphere", vec3(40.0, 10.0, 5.0), 0.2, vec3(0.1, 0.2, 0.3)),
+        rectangle_case(
+            "rectangle overhead",
+            vec3(-1.0, 0.5, -0.7),
+            vec3(2.0, 0.0, 0.0),
+            vec3(0.0, 0.0, 1.4),
+            Vec3::ZERO,
+        ),
+        rectangle_case(
+            "oblique rectangle off to the side",
+            vec3(0.4, 0.2, 0.9),
+            vec3(0.6, 0.8, 0.0),
+            vec3(0.0, 0.0, 0.7),
+            vec3(-0.3, 0.1, 0.0),
+        ),
+        rectangle_case(
+            "far rectangle (area sampling)",
+            vec3(20.0, 0.0, 0.0),
+            vec3(0.0, 0.1, 0.0),
+            vec3(0.0, 0.0, 0.1),
+            Vec3::ZERO,
+        ),
+    ]
+}
+
+/// The direction through tangent-plane coordinates (x, y).
+fn direction(frame: &Frame, x: f32, y: f32) -> Vec3 {
+    frame.to_world(vec3(x, y, 1.0)).normalize()
+}
+
+/// pdf · dω/dxdy at tangent-plane coordinates (x, y), and whether that direction meets the light.
+fn density(c: &Case, frame: &Frame, x: f64, y: f64) -> (f64, bool) {
+    let w = direction(frame, x as f32, y as f32);
+    let Some((q, n)) = (c.hit)(c.p, w) else { return (0.0, false) };
+    (c.light.pdf_li(c.p, w, q, n) as f64 * (1.0 + x * x + y * y).powf(-1.5), true)
+}
+
+/// ∫ over the square cell at (x, y) of side h: a 2×2 Gauss rule where the cell lies wholly
+/// on or off the light (by a 3×3 grid of probes), split in four where the edge crosses it.
+fn integrate_cell(c: &Case, frame: &Frame, x: f64, y: f64, h: f64, depth: u32) -> f64 {
+    let probes = [0.0, 0.5, 1.0];
+    let hits = probes
+        .iter()
+        .flat_map(|a| probes.iter().map(move |b| (a, b)))
+        .filter(|(a, b)| density(c, frame, x + *a * h, y + *b * h).1)
+        .count();
+    if hits == 0 || hits == 9 || depth == 0 {
+        if hits == 0 {
+            return 0.0;
+        }
+        let g = 0.5 - 0.5 / 3f64.sqrt();
+        let nodes = [(g, g), (1.0 - g, g), (g, 1.0 - g), (1.0 - g, 1.0 - g)];
+        return nodes.iter().map(|(a, b)| density(c, frame, x + a * h, y + b * h).0).sum::<f64>() * h * h / 4.0;
+    }
+    let k = h / 2.0;
+    [(0.0, 0.0), (k, 0.0), (0.0, k), (k, k)]
+        .iter()
+        .map(|(a, b)| integrate_cell(c, frame, x + a, y + b, k, depth - 1))
+        .sum()
+}
+
+/// ∫ pdf dω over each bin (dω = dx dy / (1 + x² + y²)^(3/2) on the tangent plane).
+fn expected_fractions(c: &Case, frame: &Frame) -> Vec<f64> {
+    let e = c.extent as f64;
+    let h = 2.0 * e / (BINS * SUB) as f64;
+    let mut bins = vec![0.0f64; BINS * BINS];
+    for i in 0..BINS * SUB {
+        for j in 0..BINS * SUB {
+            let (x, y) = (-e + i as f64 * h, -e + j as f64 * h);
+            bins[(i / SUB) * BINS + j / SUB] += integrate_cell(c, frame, x, y, h, REFINE);
+        }
+    }
+    bins
+}
+
+#[test]
+fn light_samplers_draw_the_density_they_report() {
+    let all = cases();
+    let alpha = sidak(FALSE_ALARM, all.len());
+    let mut failures = Vec::new();
+    for (k, c) in all.iter().enumerate() {
+        let frame = Frame::from_normal(c.axis);
+        let mut rng = Rng::new(0x5eed + k as u64, 0);
+        let mut observed = vec![0u64; BINS * BINS + 1];
+        let mut worst_pdf_mismatch = 0.0f64;
+        for _ in 0..SAMPLES {
+            let u = [rng.next_f32(), rng.next_f32()];
+            let Some(ls) = c.light.sample_li(c.p, u) else {
+                observed[BINS * BINS] += 1;
+                continue;
+            };
+            let l = frame.to_local(ls.wi);
+            let (x, y) = (l.x / l.z, l.y / l.z);
+            let cell = |v: f32| ((v + c.extent) / (2.0 * c.extent) * BINS as f32).floor();
+            let (bx, by) = (cell(x), cell(y));
+            if l.z <= 0.0 || !(0.0..BINS as f32).contains(&bx) || !(0.0..BINS as f32).contains(&by) {
+                observed[BINS * BINS] += 1;
+                continue;
+            }
+            observed[bx as usize * BINS + by as usize] += 1;
+            // The density a BSDF-sampled ray along the same direction would be given.
+            if let Some((q, n)) = (c.hit)(c.p, ls.wi) {
+                let pdf = c.light.pdf_li(c.p, ls.wi, q, n) as f64;
+                worst_pdf_mismatch = worst_pdf_mismatch.max((pdf / ls.pdf as f64 - 1.0).abs());
+            }
+        }
+        let fractions = expected_fractions(c, &frame);
+        let total: f64 = fractions.iter().sum();
+        let mut expected: Vec<f64> = fractions.iter().map(|f| f * SAMPLES as f64).collect();
+        // Outside the grid or no sample: nothing is expected there (a tiny amount lets the
+        // quadrature's shortfall be pooled rather than declared impossible).
+        expected.push((SAMPLES as f64 * (1.0 - total)).max(1e-9));
+        let outcome = chi2_test(&observed, &expected);
+        println!("{}: ∫pdf = {total:.5}, worst pdf mismatch {worst_pdf_mismatch:.2e}, {outcome:?}", c.label);
+        // The quadrature's error along the silhouette is far below this.
+        if (total - 1.0).abs() > 1e-3 {
+            failures.push(format!("{}: the density integrates to {total:.5}, not 1", c.label));
+        }
+        if worst_pdf_mismatch > 1e-3 {
+            failures.push(format!("{}: pdf_li differs from the sample's pdf by {worst_pdf_mismatch:.2e}", c.label));
+        }
+        match outcome {
+            Ok(o) if o.p_value >= alpha => {}
+            Ok(o) => failures
+                .push(format!("{}: chi-square {:.1} on {} dof, p = {:.2e}", c.label, o.statistic, o.dof, o.p_value)),
+            Err(e) => failures.push(format!("{}: {e}", c.label)),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
