@@ -62,17 +62,20 @@ struct Reader<'a> {
     shapes: Vec<ShapeDesc>,
     lights: Vec<LightDesc>,
     warnings: Vec<String>,
+    /// The scene's tree, for resolving file names through its search path.
+    tree: &'a xml::SceneTree,
+    source: xml::IncludeSource<'a>,
 }
 
 pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    describe_tree(path, xml::load_tree(path, &defines)?)
+    describe_tree(path, &xml::load_tree(path, &defines)?, xml::IncludeSource::Disk)
 }
 
 /// Reads a Mitsuba scene given as text (for fuzzing and in-memory scenes); `path` names it.
 pub fn read_str(text: &str, path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    describe_tree(path, xml::load_tree_str(text, path, &defines, xml::IncludeSource::Disk)?)
+    describe_tree(path, &xml::load_tree_str(text, path, &defines, xml::IncludeSource::Disk)?, xml::IncludeSource::Disk)
 }
 
 /// [`read_str`] with `<include>`s read from `files` (path to text) instead of the disk: a
@@ -84,12 +87,15 @@ pub fn read_str_with_includes(
     files: &HashMap<std::path::PathBuf, String>,
 ) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    describe_tree(path, xml::load_tree_str(text, path, &defines, xml::IncludeSource::Memory(files))?)
+    let source = xml::IncludeSource::Memory(files);
+    describe_tree(path, &xml::load_tree_str(text, path, &defines, source)?, source)
 }
 
-fn describe_tree(path: &Path, tree: xml::SceneTree) -> Result<SceneDesc, Error> {
-    let root = tree.root;
+fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::IncludeSource<'a>) -> Result<SceneDesc, Error> {
+    let root = &tree.root;
     let mut r = Reader {
+        tree,
+        source,
         named: HashMap::new(),
         material_index: HashMap::new(),
         materials: Vec::new(),
@@ -128,7 +134,7 @@ fn describe_tree(path: &Path, tree: xml::SceneTree) -> Result<SceneDesc, Error> 
     };
     let mut desc = SceneDesc::empty(camera, film);
     desc.source = Some(path.to_path_buf());
-    desc.includes = tree.included;
+    desc.includes = tree.included.clone();
     desc.integrator = integrator;
     desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp: settings_spp(sensor)?.unwrap_or(16), seed };
     desc.materials = r.materials;
@@ -168,6 +174,11 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// A plugin's `filename`, found through the scene's search path (`<path>`).
+    fn resolve_file(&self, el: &Element, name: &str) -> std::path::PathBuf {
+        self.tree.resolve(el, name, self.source)
+    }
+
     /// Follows `<ref id>` to the named object.
     fn resolve(&self, el: &'a Element) -> Result<&'a Element, Error> {
         if el.tag == "ref" {
@@ -197,7 +208,7 @@ impl<'a> Reader<'a> {
         match e.attr("type").unwrap_or("") {
             "bitmap" => {
                 let file = tp.string("filename").ok_or_else(|| e.err("bitmap texture needs 'filename'"))?;
-                let path = e.file.parent().unwrap_or(Path::new(".")).join(file);
+                let path = self.resolve_file(e, file);
                 let raw = tp.bool("raw", false)?;
                 let _ = tp.string("filter_type");
                 let _ = tp.string("wrap_mode");
@@ -349,7 +360,7 @@ impl<'a> Reader<'a> {
         let geometry = match ty {
             "obj" | "ply" => {
                 let file = p.string("filename").ok_or_else(|| el.err(format!("shape '{ty}' needs 'filename'")))?;
-                let path = el.file.parent().unwrap_or(Path::new(".")).join(file);
+                let path = self.resolve_file(el, file);
                 Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)? }
             }
             "sphere" => {
@@ -408,7 +419,7 @@ impl<'a> Reader<'a> {
             "envmap" => {
                 let file = p.string("filename").ok_or_else(|| el.err("envmap needs 'filename'"))?;
                 LightKind::EnvMap {
-                    file: el.file.parent().unwrap_or(Path::new(".")).join(file),
+                    file: self.resolve_file(el, file),
                     scale: p.float("scale", 1.0)?,
                     to_world: matrix(&to_world),
                 }
