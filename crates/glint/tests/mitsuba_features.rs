@@ -99,3 +99,41 @@ impl TapParent for PathBuf {
         self
     }
 }
+
+const FILM: &str = r#"<film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="6"/></film>"#;
+
+/// A scene-level `<sampler>` (or `<film>`) serves the sensor that refers to it, as in Mitsuba
+/// 3.9.1; one that no sensor refers to is ignored there too (glint warns).
+#[test]
+fn scene_level_sampler_and_film() {
+    let dir = scratch("sampler");
+    let scene = |name: &str, top: &str, inside: &str| {
+        let p = dir.join(name);
+        write(
+            &p,
+            &format!(
+                "<scene version=\"3.0.0\">\n{top}\n<sensor type=\"perspective\">\n{inside}\n</sensor>\n<shape type=\"sphere\"/>\n</scene>\n"
+            ),
+        );
+        p
+    };
+    let sampler = |id: &str, n: u32| {
+        format!(r#"<sampler type="independent" {id}><integer name="sample_count" value="{n}"/><integer name="seed" value="3"/></sampler>"#)
+    };
+    let d = read(&scene("ref.xml", &sampler("id=\"s\"", 7), &format!("<ref id=\"s\"/>{FILM}"))).unwrap();
+    assert_eq!((d.sampler.spp, d.sampler.seed), (7, 3));
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+    let d = read(&scene("named.xml", &sampler("id=\"s\"", 5), &format!("<ref name=\"sampler\" id=\"s\"/>{FILM}"))).unwrap();
+    assert_eq!(d.sampler.spp, 5);
+    // A scene-level film, referred to.
+    let film = FILM.replace("<film ", "<film id=\"f\" ");
+    let d = read(&scene("film.xml", &film, "<ref id=\"f\"/>")).unwrap();
+    assert_eq!((d.film.width, d.film.height), (8, 6));
+    // Unreferenced: ignored with a warning naming file and line.
+    let d = read(&scene("unused.xml", &sampler("", 7), FILM)).unwrap();
+    assert_eq!(d.sampler.spp, 16);
+    assert!(d.warnings.len() == 1 && d.warnings[0].contains("unused.xml:2:") && d.warnings[0].contains("ignored"), "{:?}", d.warnings);
+    // Two samplers for one sensor: an error, as in Mitsuba.
+    let e = read(&scene("two.xml", &sampler("id=\"s\"", 7), &format!("<ref id=\"s\"/>\n{}{FILM}", sampler("", 9)))).unwrap_err();
+    assert!(e.contains("two.xml:5:") && e.contains("only one <sampler>"), "{e}");
+}

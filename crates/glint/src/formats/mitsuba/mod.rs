@@ -118,8 +118,9 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
             "emitter" => r.emitter(c)?,
             "sensor" => sensor = Some(c),
             "integrator" => integrator_el = Some(c),
-            // Named BSDFs and textures are described when a shape refers to them.
-            "bsdf" | "texture" => {}
+            // Named BSDFs and textures are described when a shape refers to them, samplers
+            // and films when the sensor does (an unreferenced one is ignored, as by Mitsuba).
+            "bsdf" | "texture" | "sampler" | "film" => {}
             "medium" | "phase" | "volume" => {
                 return Err(c.err(format!("<{}> (participating media) is not supported", c.tag)))
             }
@@ -127,7 +128,21 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
         }
     }
     let sensor = sensor.ok_or_else(|| Error::at(&SourceLoc::file(path), "the scene has no <sensor>"))?;
-    let (camera, film, seed) = r.sensor(sensor)?;
+    let sampler_el = r.sensor_child(sensor, "sampler")?;
+    let film_el = r.sensor_child(sensor, "film")?;
+    for c in &root.children {
+        let used = [sampler_el, film_el].iter().flatten().any(|u| std::ptr::eq(*u, c));
+        if matches!(c.tag.as_str(), "sampler" | "film") && !used {
+            r.warnings.push(
+                c.err(format!(
+                    "<{}> at scene level is not used by the sensor (it would need a <ref id> there) and was ignored, as Mitsuba ignores it",
+                    c.tag
+                ))
+                .to_string(),
+            );
+        }
+    }
+    let (camera, film, seed) = r.sensor(sensor, film_el, sampler_el)?;
     let integrator = match integrator_el {
         Some(e) => r.integrator(e)?,
         None => IntegratorDesc::Path(PathSettings::default()),
@@ -136,7 +151,7 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
     desc.source = Some(path.to_path_buf());
     desc.includes = tree.included.clone();
     desc.integrator = integrator;
-    desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp: settings_spp(sensor)?.unwrap_or(16), seed };
+    desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp: settings_spp(sampler_el)?.unwrap_or(16), seed };
     desc.materials = r.materials;
     desc.shapes = r.shapes;
     desc.lights = r.lights;
@@ -144,8 +159,8 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
     Ok(desc)
 }
 
-fn settings_spp(sensor: &Element) -> Result<Option<u32>, Error> {
-    if let Some(c) = sensor.children.iter().find(|c| c.tag == "sampler") {
+fn settings_spp(sampler: Option<&Element>) -> Result<Option<u32>, Error> {
+    if let Some(c) = sampler {
         let p = Props::new(c);
         let n = p.int("sample_count", 4)?;
         let max = crate::describe::limits::MAX_SPP as i64;
@@ -432,8 +447,29 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
+    /// The sensor's `<film>` or `<sampler>`: nested, or a `<ref id>` to one at scene level
+    /// (Mitsuba accepts both); two are an error, as in Mitsuba.
+    fn sensor_child(&self, sensor: &'a Element, tag: &str) -> Result<Option<&'a Element>, Error> {
+        let mut found = None;
+        for c in &sensor.children {
+            let target = if c.tag == "ref" { self.resolve(c)? } else { c };
+            if target.tag == tag {
+                if found.is_some() {
+                    return Err(c.err(format!("only one <{tag}> can be given per sensor")));
+                }
+                found = Some(target);
+            }
+        }
+        Ok(found)
+    }
+
     /// The camera, the film and the sampler's seed.
-    fn sensor(&mut self, el: &'a Element) -> Result<(CameraDesc, FilmDesc, u64), Error> {
+    fn sensor(
+        &mut self,
+        el: &'a Element,
+        film_el: Option<&'a Element>,
+        sampler_el: Option<&'a Element>,
+    ) -> Result<(CameraDesc, FilmDesc, u64), Error> {
         let ty = el.attr("type").unwrap_or("");
         if ty != "perspective" && ty != "thinlens" {
             return Err(el.err(format!("sensor plugin '{ty}' is not supported (perspective, thinlens)")));
@@ -455,7 +491,6 @@ impl<'a> Reader<'a> {
             None if p.opt_float("fov")?.is_some() => FovAxis::X,
             None => FovAxis::Diagonal,
         };
-        let film_el = el.children.iter().find(|c| c.tag == "film");
         let mut film =
             FilmDesc { width: 768, height: 576, filter: PixelFilter::Gaussian { stddev: 0.5 }, loc: el.loc() };
         if let Some(f) = film_el {
@@ -512,7 +547,7 @@ impl<'a> Reader<'a> {
             }
         }
         let mut seed = 0;
-        if let Some(s) = el.children.iter().find(|c| c.tag == "sampler") {
+        if let Some(s) = sampler_el {
             let sp = Props::new(s);
             let v = sp.int("seed", 0)?;
             if v < 0 {
