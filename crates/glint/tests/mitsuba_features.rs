@@ -137,3 +137,90 @@ fn scene_level_sampler_and_film() {
     let e = read(&scene("two.xml", &sampler("id=\"s\"", 7), &format!("<ref id=\"s\"/>\n{}{FILM}", sampler("", 9)))).unwrap_err();
     assert!(e.contains("two.xml:5:") && e.contains("only one <sampler>"), "{e}");
 }
+
+fn close(a: glint::math::Rgb, b: [f32; 3], tol: f32) {
+    for (x, y) in [a.r, a.g, a.b].into_iter().zip(b) {
+        assert!((x - y).abs() <= tol * y.abs().max(1e-3), "{a:?} vs {b:?}");
+    }
+}
+
+/// Spectra become the RGB that Mitsuba 3.9.1's scalar_rgb variant makes of them (values
+/// printed there): reflectances through D65 and clamped to [0, 1], emitters without D65, a
+/// constant emitted spectrum not grey but `xyz_to_srgb(1, 1, 1)` times its value.
+#[test]
+fn spectra_convert_as_in_mitsubas_rgb_variants() {
+    let dir = scratch("spectra");
+    let p = dir.join("s.xml");
+    write(
+        &p,
+        &format!(
+            r#"<scene version="3.0.0">{SENSOR}
+<shape type="sphere">
+  <bsdf type="diffuse"><spectrum name="reflectance" value="400:0.78, 500:0.78, 600:0.78, 700:0.78"/></bsdf>
+  <emitter type="area"><spectrum name="radiance" value="400:0, 500:8, 600:15.6, 700:18.4"/></emitter>
+</shape>
+<shape type="sphere"><bsdf type="conductor"><spectrum name="eta" value="0.27"/><spectrum name="k" value="300:1.92, 400:1.95, 500:1.95, 600:2.97, 700:3.8, 800:5.12"/></bsdf>
+  <emitter type="area"><spectrum name="radiance" value="2"/></emitter></shape>
+<shape type="sphere"><bsdf type="diffuse"><spectrum name="reflectance" value="0.3"/></bsdf>
+  <emitter type="area"><float name="radiance" value="2"/></emitter></shape>
+<emitter type="constant"><spectrum name="radiance" type="blackbody"><float name="temperature" value="2700"/></spectrum></emitter>
+<emitter type="point"><spectrum name="intensity" value="400:1, 700:1"/></emitter>
+</scene>"#
+        ),
+    );
+    let d = read(&p).unwrap();
+    let diffuse = |i: usize| match &d.materials[i].model {
+        MaterialModel::Diffuse { reflectance: TextureDesc::Constant { color } } => *color,
+        other => panic!("{other:?}"),
+    };
+    close(diffuse(0), [0.776368, 0.779809, 0.776029], 1e-5);
+    close(d.shapes[0].emission.unwrap().radiance, [20.7108, 10.8546, 2.77115], 1e-5);
+    match &d.materials[1].model {
+        MaterialModel::Conductor { eta, k, .. } => {
+            close(*eta, [0.27, 0.27, 0.27], 0.0);
+            // Unbounded: through D65, clamped at 0 only (mi.spectrum_list_to_srgb(..., False, True)).
+            close(*k, [3.3887, 2.34904, 1.87516], 1e-5);
+        }
+        other => panic!("{other:?}"),
+    }
+    close(d.shapes[1].emission.unwrap().radiance, [2.0 * 1.20479, 2.0 * 0.948291, 2.0 * 0.908916], 1e-5);
+    close(diffuse(2), [0.3, 0.3, 0.3], 0.0);
+    close(d.shapes[2].emission.unwrap().radiance, [2.0, 2.0, 2.0], 0.0);
+    match &d.lights[0].light {
+        LightKind::Constant { radiance } => close(*radiance, [314.3371, 130.67393, 31.319273], 5e-3),
+        other => panic!("{other:?}"),
+    }
+    match &d.lights[1].light {
+        LightKind::Point { intensity, .. } => assert!(intensity.r > 0.0 && intensity.b > 0.0, "{intensity:?}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn malformed_spectra_are_errors_with_file_and_line() {
+    let dir = scratch("bad-spectra");
+    for (i, (value, expect)) in [
+        ("value=\"500:0.5\"", "at least two"),
+        ("value=\"600:0.5, 500:0.5\"", "must increase"),
+        ("value=\"500:0.5, 600\"", "wavelength:value pair"),
+        ("value=\"500:x, 600:1\"", "wavelength:value pair"),
+        ("value=\"500:nan, 600:1\"", "finite"),
+        ("value=\"abc\"", "not a number"),
+        ("filename=\"gold.spd\"", "not supported"),
+        ("type=\"regular\"", "'regular' is not supported"),
+        ("type=\"blackbody\"", "temperature"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let p = dir.join(format!("bad{i}.xml"));
+        write(
+            &p,
+            &format!(
+                "<scene version=\"3.0.0\">{SENSOR}\n<shape type=\"sphere\"><bsdf type=\"diffuse\">\n<spectrum name=\"reflectance\" {value}/>\n</bsdf></shape></scene>"
+            ),
+        );
+        let e = read(&p).unwrap_err();
+        assert!(e.contains(&format!("bad{i}.xml:4:")) && e.contains(expect), "{value}: {e}");
+    }
+}

@@ -5,6 +5,7 @@
 //! an error that names the plugin, the file and the line.
 
 mod props;
+mod spectrum;
 pub mod xml;
 
 use super::Define;
@@ -19,6 +20,7 @@ use crate::materials::conductor_preset;
 use crate::math::{Rgb, Transform, Vec3};
 use crate::sampling::{PixelFilter, SamplerKind};
 use props::{color_of, Props};
+use spectrum::SpectrumUse;
 use std::collections::HashMap;
 use std::path::Path;
 use xml::Element;
@@ -211,7 +213,7 @@ impl<'a> Reader<'a> {
         let Some(e) = p.find(name) else { return Ok(TextureDesc::constant(default)) };
         let e = self.resolve(e)?;
         if e.tag != "texture" {
-            return Ok(TextureDesc::constant(color_of(e)?));
+            return Ok(TextureDesc::constant(color_of(e, SpectrumUse::Reflectance)?));
         }
         let tp = Props::new(e);
         let to_uv = tp.transform("to_uv")?;
@@ -270,7 +272,10 @@ impl<'a> Reader<'a> {
     fn conductor_ior(&self, p: &Props) -> Result<(Rgb, Rgb), Error> {
         let (eta_el, k_el) = (p.find("eta"), p.find("k"));
         if eta_el.is_some() || k_el.is_some() {
-            return Ok((p.rgb("eta", Rgb::BLACK)?, p.rgb("k", Rgb::WHITE)?));
+            return Ok((
+                p.rgb_as("eta", Rgb::BLACK, SpectrumUse::Unbounded)?,
+                p.rgb_as("k", Rgb::WHITE, SpectrumUse::Unbounded)?,
+            ));
         }
         let name = p.string("material").unwrap_or("none");
         conductor_preset(name)
@@ -364,7 +369,10 @@ impl<'a> Reader<'a> {
                         )));
                     }
                     let ep = Props::new(c);
-                    emission = Some(Emission { radiance: ep.rgb("radiance", Rgb::WHITE)?, two_sided: false });
+                    emission = Some(Emission {
+                        radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?,
+                        two_sided: false,
+                    });
                     self.warn_unused(&ep);
                 }
                 "medium" => return Err(c.err("<medium> (participating media) is not supported")),
@@ -408,7 +416,7 @@ impl<'a> Reader<'a> {
                     Some(v) => v,
                     None => to_world.point(Vec3::ZERO),
                 },
-                intensity: p.rgb("intensity", Rgb::WHITE)?,
+                intensity: p.rgb_as("intensity", Rgb::WHITE, SpectrumUse::Emission)?,
             },
             "spot" => {
                 if p.find("texture").is_some() {
@@ -418,7 +426,7 @@ impl<'a> Reader<'a> {
                 LightKind::Spot {
                     position: to_world.point(Vec3::ZERO),
                     direction: to_world.vector(Vec3::Z),
-                    intensity: p.rgb("intensity", Rgb::WHITE)?,
+                    intensity: p.rgb_as("intensity", Rgb::WHITE, SpectrumUse::Emission)?,
                     cutoff_degrees: cutoff,
                     beam_degrees: p.float("beam_width", cutoff * 0.75)?,
                 }
@@ -428,9 +436,9 @@ impl<'a> Reader<'a> {
                     Some(v) => v,
                     None => to_world.vector(Vec3::Z),
                 },
-                irradiance: p.rgb("irradiance", Rgb::WHITE)?,
+                irradiance: p.rgb_as("irradiance", Rgb::WHITE, SpectrumUse::Emission)?,
             },
-            "constant" => LightKind::Constant { radiance: p.rgb("radiance", Rgb::WHITE)? },
+            "constant" => LightKind::Constant { radiance: p.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)? },
             "envmap" => {
                 let file = p.string("filename").ok_or_else(|| el.err("envmap needs 'filename'"))?;
                 LightKind::EnvMap {
