@@ -131,3 +131,9 @@ fn sampled_spectra_sampler_and_path() {
 fn blackbody_against_a_spectral_render() {
     check("blackbody");
 }
+
+/// Mitsuba's serialized meshes: shape_index, stored normals and uvs, face_normals.
+#[test]
+fn serialized_meshes() {
+    check("serialized");
+}

@@ -224,3 +224,194 @@ fn malformed_spectra_are_errors_with_file_and_line() {
         assert!(e.contains(&format!("bad{i}.xml:4:")) && e.contains(expect), "{value}: {e}");
     }
 }
+
+/// A tiny writer of Mitsuba's `.serialized` format (versions 3 and 4), for the tests.
+mod serialized_writer {
+    use std::io::Write;
+
+    pub struct Mesh {
+        pub name: &'static str,
+        pub positions: Vec<[f64; 3]>,
+        pub normals: Option<Vec<[f64; 3]>>,
+        pub uvs: Option<Vec<[f64; 2]>>,
+        pub colors: bool,
+        pub double: bool,
+        pub indices: Vec<[u32; 3]>,
+    }
+
+    /// The compressed body of one mesh (what follows its 4-byte header).
+    pub fn body(m: &Mesh, version: u16, vertex_count: u64, triangle_count: u64) -> Vec<u8> {
+        let mut raw = Vec::new();
+        let flags = m.normals.is_some() as u32
+            | (m.uvs.is_some() as u32) << 1
+            | (m.colors as u32) << 3
+            | if m.double { 0x2000 } else { 0x1000 };
+        raw.extend(flags.to_le_bytes());
+        if version == 4 {
+            raw.extend(m.name.as_bytes());
+            raw.push(0);
+        }
+        raw.extend(vertex_count.to_le_bytes());
+        raw.extend(triangle_count.to_le_bytes());
+        let mut put = |v: f64| {
+            if m.double {
+                raw.extend(v.to_le_bytes())
+            } else {
+                raw.extend((v as f32).to_le_bytes())
+            }
+        };
+        m.positions.iter().flatten().for_each(|&v| put(v));
+        m.normals.iter().flatten().flatten().for_each(|&v| put(v));
+        m.uvs.iter().flatten().flatten().for_each(|&v| put(v));
+        if m.colors {
+            m.positions.iter().flatten().for_each(|_| put(0.25));
+        }
+        for t in &m.indices {
+            t.iter().for_each(|i| raw.extend(i.to_le_bytes()));
+        }
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(&raw).unwrap();
+        z.finish().unwrap()
+    }
+
+    /// A whole file: each mesh after its header, then the dictionary of offsets and the count.
+    pub fn file(meshes: &[Mesh], version: u16) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut offsets = Vec::new();
+        for m in meshes {
+            offsets.push(out.len() as u64);
+            out.extend(0x041Cu16.to_le_bytes());
+            out.extend(version.to_le_bytes());
+            out.extend(body(m, version, m.positions.len() as u64, m.indices.len() as u64));
+        }
+        for o in offsets {
+            if version == 4 {
+                out.extend(o.to_le_bytes());
+            } else {
+                out.extend((o as u32).to_le_bytes());
+            }
+        }
+        out.extend((meshes.len() as u32).to_le_bytes());
+        out
+    }
+
+    pub fn quad(name: &'static str, double: bool) -> Mesh {
+        Mesh {
+            name,
+            positions: vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]],
+            normals: Some(vec![[0.0, 0.0, 1.0]; 4]),
+            uvs: Some(vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
+            colors: false,
+            double,
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    pub fn triangle(name: &'static str) -> Mesh {
+        Mesh {
+            name,
+            positions: vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0]],
+            normals: None,
+            uvs: None,
+            colors: true,
+            double: false,
+            indices: vec![[0, 1, 2]],
+        }
+    }
+}
+
+#[test]
+fn serialized_meshes_are_read_by_index() {
+    use glint::io::serialized::parse_serialized;
+    use serialized_writer::{file, quad, triangle};
+    for version in [3u16, 4] {
+        let data = file(&[quad("plane", false), triangle("tri"), quad("plane64", true)], version);
+        let m = parse_serialized(&data, 0).unwrap();
+        assert_eq!((m.positions.len(), m.indices.len()), (4, 2));
+        assert_eq!(m.uvs.as_ref().unwrap()[2], [1.0, 1.0]);
+        assert_eq!(m.normals.as_ref().unwrap()[0].z, 1.0);
+        assert_eq!(m.name, if version == 4 { "plane" } else { "" });
+        let t = parse_serialized(&data, 1).unwrap();
+        assert_eq!(t.indices, vec![[0, 1, 2]]);
+        assert!(t.normals.is_none() && t.uvs.is_none());
+        assert_eq!(t.positions[2].y, 3.0);
+        let d = parse_serialized(&data, 2).unwrap();
+        assert_eq!(d.positions[1].x, 1.0);
+        let e = parse_serialized(&data, 3).unwrap_err();
+        assert!(e.contains("out of range") && e.contains("3 meshes"), "{e}");
+    }
+    // Through the scene reader and the builder: shape_index, to_world, face_normals.
+    let dir = scratch("serialized");
+    std::fs::write(dir.join("m.serialized"), file(&[quad("plane", false), triangle("tri")], 4)).unwrap();
+    let p = dir.join("s.xml");
+    write(
+        &p,
+        &format!(
+            r#"<scene version="3.0.0">{SENSOR}
+<shape type="serialized"><string name="filename" value="m.serialized"/><integer name="shape_index" value="1"/>
+  <transform name="to_world"><translate z="-5"/></transform></shape>
+<shape type="serialized"><string name="filename" value="m.serialized"/><boolean name="face_normals" value="true"/></shape>
+</scene>"#
+        ),
+    );
+    let d = read(&p).unwrap();
+    assert!(matches!(d.shapes[0].geometry, Geometry::MeshFile { shape_index: 1, face_normals: false, .. }));
+    assert!(matches!(d.shapes[1].geometry, Geometry::MeshFile { shape_index: 0, face_normals: true, .. }));
+    let s = load(&p, &[], None).unwrap();
+    assert_eq!(s.world.triangle_count(), 3);
+}
+
+/// Every size read from the file is bounded before allocation and the data checked really
+/// there: truncated files, lying counts, bad offsets and indices are one-line errors.
+#[test]
+fn serialized_robustness() {
+    use glint::io::serialized::parse_serialized;
+    use serialized_writer::{body, file, quad, triangle};
+    let data = file(&[quad("plane", false), triangle("tri")], 4);
+    // Every truncation, of either mesh: an error, never a panic.
+    for n in 0..data.len() {
+        for index in [0, 1] {
+            if let Ok(m) = parse_serialized(&data[..n], index) {
+                // Only cuts inside the dictionary can leave mesh 0 readable.
+                assert_eq!((index, m.indices.len()), (0, 2), "prefix {n}");
+            }
+        }
+    }
+    let e = parse_serialized(&data[..30], 0).unwrap_err();
+    assert!(e.contains("mesh 0"), "{e}");
+    // Huge counts with almost no data: refused before any allocation.
+    let q = quad("q", false);
+    for (v, f) in [(u32::MAX as u64, u32::MAX as u64), (1 << 40, 2), (4, 1 << 33), (50_000_000, 1)] {
+        let mut d = vec![0x1C, 0x04, 4, 0];
+        d.extend(body(&q, 4, v, f));
+        let e = parse_serialized(&d, 0).unwrap_err();
+        assert!(e.contains("vertices") && (e.contains("more than") || e.contains("truncated")), "{v} {f}: {e}");
+    }
+    // A count that fits the deflate bound but is not there: truncated, not a huge buffer.
+    let mut d = vec![0x1C, 0x04, 4, 0];
+    d.extend(body(&q, 4, 1000, 1));
+    let e = parse_serialized(&d, 0).unwrap_err();
+    assert!(e.contains("truncated"), "{e}");
+    // A dictionary claiming four billion meshes, and one whose offset points past the file.
+    let mut d = data.clone();
+    let n = d.len();
+    d[n - 4..].copy_from_slice(&u32::MAX.to_le_bytes());
+    let e = parse_serialized(&d, 7).unwrap_err();
+    assert!(e.contains("dictionary"), "{e}");
+    let mut d = data.clone();
+    d[n - 12..n - 4].copy_from_slice(&u64::MAX.to_le_bytes());
+    let e = parse_serialized(&d, 1).unwrap_err();
+    assert!(e.contains("past the end"), "{e}");
+    // A triangle naming a vertex that does not exist; a wrong magic; version 5.
+    let mut bad = triangle("t");
+    bad.indices = vec![[0, 1, 3]];
+    let e = parse_serialized(&file(&[bad], 4), 0).unwrap_err();
+    assert!(e.contains("triangle 0 uses vertex 3"), "{e}");
+    let e = parse_serialized(b"\x00\x00\x04\x00rest", 0).unwrap_err();
+    assert!(e.contains("format identifier"), "{e}");
+    let e = parse_serialized(b"\x1c\x04\x05\x00rest", 0).unwrap_err();
+    assert!(e.contains("version 5"), "{e}");
+    // Garbage after a valid header: a decompression error.
+    let e = parse_serialized(b"\x1c\x04\x04\x00not zlib at all", 0).unwrap_err();
+    assert!(e.contains("mesh 0"), "{e}");
+}

@@ -384,7 +384,19 @@ impl<'a> Reader<'a> {
             "obj" | "ply" => {
                 let file = p.string("filename").ok_or_else(|| el.err(format!("shape '{ty}' needs 'filename'")))?;
                 let path = self.resolve_file(el, file);
-                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)? }
+                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)?, shape_index: 0 }
+            }
+            "serialized" => {
+                let file = p.string("filename").ok_or_else(|| el.err("shape 'serialized' needs 'filename'"))?;
+                let path = self.resolve_file(el, file);
+                if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("serialized")) {
+                    return Err(el.err(format!("serialized: glint reads these meshes from .serialized files, not '{file}'")));
+                }
+                let index = p.int("shape_index", 0)?;
+                if !(0..=u32::MAX as i64).contains(&index) {
+                    return Err(el.err(format!("serialized: shape_index {index} must be 0 or more")));
+                }
+                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)?, shape_index: index as u32 }
             }
             "sphere" => {
                 Geometry::Sphere { center: p.point("center")?.unwrap_or(Vec3::ZERO), radius: p.float("radius", 1.0)? }
