@@ -415,3 +415,48 @@ fn serialized_robustness() {
     let e = parse_serialized(b"\x1c\x04\x04\x00not zlib at all", 0).unwrap_err();
     assert!(e.contains("mesh 0"), "{e}");
 }
+
+/// A scene with several unsupported features reports every one, a line each with file and
+/// line, then fails; media anywhere are errors (not ignored parameters).
+#[test]
+fn every_unsupported_feature_is_reported() {
+    let dir = scratch("many");
+    let p = dir.join("many.xml");
+    write(
+        &p,
+        &format!(
+            r#"<scene version="3.0.0">
+{SENSOR}
+<shape type="cylinder"/>
+<shape type="sphere">
+  <bsdf type="velvet"/>
+  <medium type="homogeneous" name="interior"/>
+</shape>
+<emitter type="projector"/>
+<medium type="homogeneous" id="fog"/>
+<shape type="sphere"><ref name="exterior" id="fog"/></shape>
+<shape type="hair"><bsdf type="velvet"/></shape>
+<bsdf type="blendbsdf" id="b"/>
+<shape type="sphere"><ref id="b"/></shape>
+<shape type="sphere"><ref id="b"/></shape>
+</scene>"#
+        ),
+    );
+    let e = read(&p).unwrap_err();
+    let lines: Vec<&str> = e.lines().collect();
+    let expect = [
+        (4, "cylinder"),
+        (6, "velvet"),
+        (7, "medium"),
+        (9, "projector"),
+        (10, "participating media"),
+        (11, "medium"),
+        (12, "velvet"),
+        (12, "hair"),
+        (13, "blendbsdf"),
+    ];
+    assert_eq!(lines.len(), expect.len(), "{e}");
+    for ((line, what), got) in expect.iter().zip(&lines) {
+        assert!(got.contains(&format!("many.xml:{line}:")) && got.contains(what), "expected line {line} ({what}): {got}\n{e}");
+    }
+}

@@ -64,6 +64,8 @@ struct Reader<'a> {
     shapes: Vec<ShapeDesc>,
     lights: Vec<LightDesc>,
     warnings: Vec<String>,
+    /// Errors found so far: a scene's unsupported features are all reported, one a line.
+    errors: Vec<Error>,
     /// The scene's tree, for resolving file names through its search path.
     tree: &'a xml::SceneTree,
     source: xml::IncludeSource<'a>,
@@ -104,6 +106,7 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
         shapes: Vec::new(),
         lights: Vec::new(),
         warnings: Vec::new(),
+        errors: Vec::new(),
     };
     for c in &root.children {
         if let Some(id) = c.attr("id") {
@@ -114,51 +117,98 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
     }
     let mut sensor = None;
     let mut integrator_el = None;
+    // Each object that fails adds its error and the reader goes on, so that one run reports
+    // every unsupported feature of the scene.
     for c in &root.children {
-        match c.tag.as_str() {
-            "shape" => r.shape(c)?,
-            "emitter" => r.emitter(c)?,
-            "sensor" => sensor = Some(c),
-            "integrator" => integrator_el = Some(c),
+        let result = match c.tag.as_str() {
+            "shape" => r.shape(c),
+            "emitter" => r.emitter(c),
+            "sensor" => {
+                sensor = Some(c);
+                Ok(())
+            }
+            "integrator" => {
+                integrator_el = Some(c);
+                Ok(())
+            }
             // Named BSDFs and textures are described when a shape refers to them, samplers
             // and films when the sensor does (an unreferenced one is ignored, as by Mitsuba).
-            "bsdf" | "texture" | "sampler" | "film" => {}
+            "bsdf" | "texture" | "sampler" | "film" => Ok(()),
             "medium" | "phase" | "volume" => {
-                return Err(c.err(format!("<{}> (participating media) is not supported", c.tag)))
+                Err(c.err(format!("<{}> (participating media) is not supported", c.tag)))
             }
-            other => return Err(c.err(format!("unexpected element <{other}> in <scene>"))),
-        }
+            other => Err(c.err(format!("unexpected element <{other}> in <scene>"))),
+        };
+        r.note(result);
     }
-    let sensor = sensor.ok_or_else(|| Error::at(&SourceLoc::file(path), "the scene has no <sensor>"))?;
-    let sampler_el = r.sensor_child(sensor, "sampler")?;
-    let film_el = r.sensor_child(sensor, "film")?;
-    for c in &root.children {
-        let used = [sampler_el, film_el].iter().flatten().any(|u| std::ptr::eq(*u, c));
-        if matches!(c.tag.as_str(), "sampler" | "film") && !used {
-            r.warnings.push(
-                c.err(format!(
-                    "<{}> at scene level is not used by the sensor (it would need a <ref id> there) and was ignored, as Mitsuba ignores it",
-                    c.tag
-                ))
-                .to_string(),
-            );
-        }
+    let described = r.describe_sensor(path, sensor, integrator_el);
+    let described = r.note(described);
+    if let Some(e) = Error::many(std::mem::take(&mut r.errors)) {
+        return Err(e);
     }
-    let (camera, film, seed) = r.sensor(sensor, film_el, sampler_el)?;
-    let integrator = match integrator_el {
-        Some(e) => r.integrator(e)?,
-        None => IntegratorDesc::Path(PathSettings::default()),
-    };
+    let (camera, film, seed, spp, integrator) = described.expect("no errors, so described");
     let mut desc = SceneDesc::empty(camera, film);
     desc.source = Some(path.to_path_buf());
     desc.includes = tree.included.clone();
     desc.integrator = integrator;
-    desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp: settings_spp(sampler_el)?.unwrap_or(16), seed };
+    desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp, seed };
     desc.materials = r.materials;
     desc.shapes = r.shapes;
     desc.lights = r.lights;
     desc.warnings = r.warnings;
     Ok(desc)
+}
+
+impl<'a> Reader<'a> {
+    /// The most errors one run reports.
+    const MAX_ERRORS: usize = 100;
+
+    /// Keeps an error (once: a BSDF shared by several shapes fails once) and goes on.
+    fn note<T>(&mut self, result: Result<T, Error>) -> Option<T> {
+        match result {
+            Ok(v) => Some(v),
+            Err(e) => {
+                if self.errors.len() < Self::MAX_ERRORS && !self.errors.contains(&e) {
+                    self.errors.push(e);
+                } else if self.errors.len() == Self::MAX_ERRORS {
+                    self.errors.push(Error::new(format!("(more errors; the first {} are shown)", Self::MAX_ERRORS)));
+                }
+                None
+            }
+        }
+    }
+
+    /// The camera, film, seed, samples per pixel and integrator.
+    #[allow(clippy::type_complexity)]
+    fn describe_sensor(
+        &mut self,
+        path: &Path,
+        sensor: Option<&'a Element>,
+        integrator_el: Option<&'a Element>,
+    ) -> Result<(CameraDesc, FilmDesc, u64, u32, IntegratorDesc), Error> {
+        let root = &self.tree.root;
+        let sensor = sensor.ok_or_else(|| Error::at(&SourceLoc::file(path), "the scene has no <sensor>"))?;
+        let sampler_el = self.sensor_child(sensor, "sampler")?;
+        let film_el = self.sensor_child(sensor, "film")?;
+        for c in &root.children {
+            let used = [sampler_el, film_el].iter().flatten().any(|u| std::ptr::eq(*u, c));
+            if matches!(c.tag.as_str(), "sampler" | "film") && !used {
+                self.warnings.push(
+                    c.err(format!(
+                        "<{}> at scene level is not used by the sensor (it would need a <ref id> there) and was ignored, as Mitsuba ignores it",
+                        c.tag
+                    ))
+                    .to_string(),
+                );
+            }
+        }
+        let (camera, film, seed) = self.sensor(sensor, film_el, sampler_el)?;
+        let integrator = match integrator_el {
+            Some(e) => self.integrator(e)?,
+            None => IntegratorDesc::Path(PathSettings::default()),
+        };
+        Ok((camera, film, seed, settings_spp(sampler_el)?.unwrap_or(16), integrator))
+    }
 }
 
 fn settings_spp(sampler: Option<&Element>) -> Result<Option<u32>, Error> {
@@ -180,6 +230,12 @@ fn matrix(t: &Transform) -> crate::describe::Matrix4 {
 
 impl<'a> Reader<'a> {
     fn warn_unused(&mut self, p: &Props) {
+        for c in &p.el.children {
+            let medium = c.tag == "medium" || (c.tag == "ref" && self.resolve(c).is_ok_and(|t| t.tag == "medium"));
+            if medium {
+                self.note::<()>(Err(c.err("<medium> (participating media) is not supported")));
+            }
+        }
         for (name, line) in p.unused() {
             self.warnings.push(format!(
                 "{}:{}: <{} type=\"{}\">: parameter '{name}' is not supported and was ignored",
@@ -351,33 +407,22 @@ impl<'a> Reader<'a> {
         // BSDF: a nested <bsdf> or a <ref> to one.
         let mut material = None;
         let mut emission = None;
+        // Each child's error is kept and the next child read, so that a shape with several
+        // unsupported features reports them all.
+        let errors_before = self.errors.len();
         for c in &el.children {
-            match c.tag.as_str() {
-                "bsdf" => material = Some(self.material(c)?),
-                "ref" => {
-                    let target = self.resolve(c)?;
-                    match target.tag.as_str() {
-                        "bsdf" => material = Some(self.material(target)?),
-                        other => return Err(c.err(format!("a shape cannot refer to a <{other}>"))),
-                    }
-                }
-                "emitter" => {
-                    if c.attr("type") != Some("area") {
-                        return Err(c.err(format!(
-                            "emitter '{}' cannot be attached to a shape (only 'area')",
-                            c.attr("type").unwrap_or("")
-                        )));
-                    }
-                    let ep = Props::new(c);
-                    emission = Some(Emission {
-                        radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?,
-                        two_sided: false,
-                    });
-                    self.warn_unused(&ep);
-                }
-                "medium" => return Err(c.err("<medium> (participating media) is not supported")),
-                _ => {}
-            }
+            let result = match c.tag.as_str() {
+                "bsdf" => self.material(c).map(|m| material = Some(m)),
+                "ref" => self.resolve(c).and_then(|target| match target.tag.as_str() {
+                    "bsdf" => self.material(target).map(|m| material = Some(m)),
+                    "medium" => Err(c.err("<medium> (participating media) is not supported")),
+                    other => Err(c.err(format!("a shape cannot refer to a <{other}>"))),
+                }),
+                "emitter" => self.area_emitter(c).map(|e| emission = Some(e)),
+                "medium" => Err(c.err("<medium> (participating media) is not supported")),
+                _ => Ok(()),
+            };
+            self.note(result);
         }
         let material = material.map_or(MaterialRef::DefaultDiffuse, MaterialRef::Index);
         let geometry = match ty {
@@ -407,6 +452,9 @@ impl<'a> Reader<'a> {
             other => return Err(el.err(format!("shape plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
+        if self.errors.len() > errors_before {
+            return Ok(());
+        }
         self.shapes.push(ShapeDesc {
             geometry,
             to_world: matrix(&to_world),
@@ -417,6 +465,19 @@ impl<'a> Reader<'a> {
             loc: el.loc(),
         });
         Ok(())
+    }
+
+    fn area_emitter(&mut self, c: &'a Element) -> Result<Emission, Error> {
+        if c.attr("type") != Some("area") {
+            return Err(c.err(format!(
+                "emitter '{}' cannot be attached to a shape (only 'area')",
+                c.attr("type").unwrap_or("")
+            )));
+        }
+        let ep = Props::new(c);
+        let emission = Emission { radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?, two_sided: false };
+        self.warn_unused(&ep);
+        Ok(emission)
     }
 
     fn emitter(&mut self, el: &'a Element) -> Result<(), Error> {
