@@ -19,7 +19,10 @@ fn main() {
     if let Err(e) = commands::run(cli) {
         // An interrupted render has already said what it wrote.
         if !e.message.is_empty() {
-            eprintln!("glint: error: {}", e.message);
+            // Several errors (a scene's unsupported features) come one a line.
+            for line in e.message.lines() {
+                eprintln!("glint: error: {line}");
+            }
         }
         std::process::exit(e.code);
     }

@@ -219,3 +219,21 @@ fn good_scene_renders_and_writes_the_file() {
         .unwrap();
     assert!(o.status.success() && o.stderr.is_empty() && o.stdout.is_empty());
 }
+
+/// A Mitsuba scene with several unsupported features: one line each, every one with file and
+/// line, then a non-zero exit.
+#[test]
+fn mitsuba_scene_reports_every_unsupported_feature() {
+    let f = Fixture::new("mitsuba-many");
+    let scene = f.write(
+        "many.xml",
+        b"<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n<shape type=\"cylinder\"/>\n<shape type=\"sphere\"><bsdf type=\"velvet\"/></shape>\n<emitter type=\"projector\"/>\n</scene>\n",
+    );
+    let out = f.dir.join("out.png");
+    let err = fails(&render_args(scene.to_str().unwrap(), out.to_str().unwrap()), &out);
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 3, "{err}");
+    for (line, (n, what)) in lines.iter().zip([(3, "cylinder"), (4, "velvet"), (5, "projector")]) {
+        assert!(line.starts_with("glint: error: ") && line.contains(&format!("many.xml:{n}:")) && line.contains(what), "{err}");
+    }
+}

@@ -44,14 +44,24 @@ impl fmt::Display for SourceLoc {
 pub struct Error {
     pub loc: Option<SourceLoc>,
     pub message: String,
+    /// Further errors found in the same run (a scene with several unsupported features
+    /// reports them all), each shown on a line of its own after this one.
+    pub also: Vec<Error>,
 }
 
 impl Error {
     pub fn new(message: impl Into<String>) -> Error {
-        Error { loc: None, message: message.into() }
+        Error { loc: None, message: message.into(), also: Vec::new() }
+    }
+    /// The first of `errors`, with the rest as [`Error::also`]; `None` for none.
+    pub fn many(errors: Vec<Error>) -> Option<Error> {
+        let mut it = errors.into_iter();
+        let mut first = it.next()?;
+        first.also.extend(it);
+        Some(first)
     }
     pub fn at(loc: &SourceLoc, message: impl Into<String>) -> Error {
-        Error { loc: loc.is_known().then(|| loc.clone()), message: message.into() }
+        Error { loc: loc.is_known().then(|| loc.clone()), message: message.into(), also: Vec::new() }
     }
     /// Adds a location to an error that has none (an inner error gets its entity's place).
     pub fn or_at(mut self, loc: &SourceLoc) -> Error {
@@ -80,9 +90,13 @@ fn one_line(s: &str) -> String {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match &self.loc {
-            Some(loc) => write!(f, "{}: {}", one_line(&loc.to_string()), one_line(&self.message)),
-            None => write!(f, "{}", one_line(&self.message)),
+            Some(loc) => write!(f, "{}: {}", one_line(&loc.to_string()), one_line(&self.message))?,
+            None => write!(f, "{}", one_line(&self.message))?,
         }
+        for e in &self.also {
+            write!(f, "\n{e}")?;
+        }
+        Ok(())
     }
 }
 

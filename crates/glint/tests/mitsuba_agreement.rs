@@ -139,3 +139,23 @@ fn mitsubas_own_cornell_box_means() {
     eprintln!("{name}: means {ours:?} vs Mitsuba's {theirs:?}");
     assert_means_agree(name, ours, theirs);
 }
+
+/// Wavelength:value spectra (reflectances, conductor eta and k, an area light), a scene-level
+/// sampler and a `<path>` (the texture is found through it).
+#[test]
+fn sampled_spectra_sampler_and_path() {
+    check("spectra");
+}
+
+/// A blackbody light and a constant-spectrum sky over flat reflectances, against Mitsuba's
+/// scalar_spectral render (the one variant that renders blackbodies).
+#[test]
+fn blackbody_against_a_spectral_render() {
+    check("blackbody");
+}
+
+/// Mitsuba's serialized meshes: shape_index, stored normals and uvs, face_normals.
+#[test]
+fn serialized_meshes() {
+    check("serialized");
+}

@@ -6,7 +6,7 @@ use crate::accel::BvhSplit;
 use crate::camera::Camera;
 use crate::describe::Emission;
 use crate::geometry::{Sphere, TriangleMesh};
-use crate::io::{obj, ply};
+use crate::io::{obj, ply, serialized};
 use crate::lights::LightSelection;
 use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
@@ -42,9 +42,26 @@ impl LoadedGroup {
 }
 
 /// Reads an OBJ (one group per material) or PLY file and builds each group's BVH.
-pub fn read_mesh_file(path: &Path, face_normals: bool, split: BvhSplit) -> Result<Vec<LoadedGroup>, String> {
+pub fn read_mesh_file(
+    path: &Path,
+    face_normals: bool,
+    shape_index: u32,
+    split: BvhSplit,
+) -> Result<Vec<LoadedGroup>, String> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
+        "serialized" => {
+            let m = serialized::read_serialized(path, shape_index)?;
+            // Mitsuba computes smooth normals for a serialized mesh that stores none.
+            let normals = match (face_normals, m.normals) {
+                (true, _) => None,
+                (false, Some(n)) => Some(n),
+                (false, None) => Some(serialized::angle_weighted_normals(&m.positions, &m.indices)),
+            };
+            let mesh = TriangleMesh::new(m.positions, normals, m.uvs, m.indices, split)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            Ok(vec![LoadedGroup::primitive(mesh)])
+        }
         "obj" => {
             let f = obj::read_obj(path)?;
             let mut out = Vec::new();
@@ -64,7 +81,7 @@ pub fn read_mesh_file(path: &Path, face_normals: bool, split: BvhSplit) -> Resul
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             Ok(vec![LoadedGroup::primitive(mesh)])
         }
-        _ => Err(format!("{}: unknown mesh format (expected .obj or .ply)", path.display())),
+        _ => Err(format!("{}: unknown mesh format (expected .obj, .ply or .serialized)", path.display())),
     }
 }
 

@@ -40,6 +40,7 @@ enum Source {
     File {
         file: PathBuf,
         face_normals: bool,
+        shape_index: u32,
     },
     /// An in-description mesh or a primitive, by shape index and a hash of its geometry (so
     /// a shape whose geometry was replaced is not served a stale mesh).
@@ -144,25 +145,32 @@ pub fn build_cached(
 
 /// Loads the mesh files not yet cached, in parallel, each once.
 fn load_files(desc: &SceneDesc, split: BvhSplit, cache: &mut MeshCache, b: &mut WorldBuilder) -> Result<(), Error> {
-    let mut files: Vec<(PathBuf, bool)> = desc.meshes.iter().map(|m| (m.file.clone(), m.face_normals)).collect();
+    let mut files: Vec<(PathBuf, bool, u32)> =
+        desc.meshes.iter().map(|m| (m.file.clone(), m.face_normals, 0)).collect();
     for s in &desc.shapes {
-        if let Geometry::MeshFile { file, face_normals } = &s.geometry {
-            files.push((file.clone(), *face_normals));
+        if let Geometry::MeshFile { file, face_normals, shape_index } = &s.geometry {
+            files.push((file.clone(), *face_normals, *shape_index));
         }
     }
     files.sort();
     files.dedup();
-    files.retain(|(file, face_normals)| {
-        !cache.groups.contains_key(&Source::File { file: file.clone(), face_normals: *face_normals })
+    files.retain(|(file, face_normals, shape_index)| {
+        !cache.groups.contains_key(&Source::File {
+            file: file.clone(),
+            face_normals: *face_normals,
+            shape_index: *shape_index,
+        })
     });
     let start = std::time::Instant::now();
-    let loaded: Vec<Result<Vec<LoadedGroup>, String>> =
-        files.par_iter().map(|(file, face_normals)| read_mesh_file(file, *face_normals, split)).collect();
+    let loaded: Vec<Result<Vec<LoadedGroup>, String>> = files
+        .par_iter()
+        .map(|(file, face_normals, shape_index)| read_mesh_file(file, *face_normals, *shape_index, split))
+        .collect();
     b.build_seconds += start.elapsed().as_secs_f64();
-    for ((file, face_normals), result) in files.into_iter().zip(loaded) {
+    for ((file, face_normals, shape_index), result) in files.into_iter().zip(loaded) {
         let groups = result.map_err(|e| Error::at(&mesh_loc(desc, &file), e))?;
         cache.counters.mesh_bvh_builds += groups.len() as u64;
-        cache.groups.insert(Source::File { file, face_normals }, groups);
+        cache.groups.insert(Source::File { file, face_normals, shape_index }, groups);
     }
     Ok(())
 }
@@ -186,14 +194,14 @@ fn add_shape(
     let to_world = transform_of(&s.to_world)?;
     let material = material_id(b, s.material, material_ids)?;
     let (source, instanced) = match &s.geometry {
-        Geometry::MeshFile { file, face_normals } => {
-            (Source::File { file: file.clone(), face_normals: *face_normals }, false)
+        Geometry::MeshFile { file, face_normals, shape_index } => {
+            (Source::File { file: file.clone(), face_normals: *face_normals, shape_index: *shape_index }, false)
         }
         Geometry::Instance { mesh } => {
             let m = desc.meshes.get(*mesh).ok_or_else(|| {
                 Error::new(format!("mesh index {mesh} is out of range ({} meshes)", desc.meshes.len()))
             })?;
-            (Source::File { file: m.file.clone(), face_normals: m.face_normals }, true)
+            (Source::File { file: m.file.clone(), face_normals: m.face_normals, shape_index: 0 }, true)
         }
         Geometry::Sphere { center, radius } => {
             return Ok(b.add_sphere(*center, *radius, &to_world, material, s.emission, s.flip_normals)?);

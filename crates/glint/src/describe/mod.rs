@@ -211,10 +211,13 @@ pub struct Emission {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
 pub enum Geometry {
-    /// An OBJ or PLY file, its transform baked into the vertices.
+    /// An OBJ, PLY or Mitsuba `.serialized` file, its transform baked into the vertices.
     MeshFile {
         file: PathBuf,
         face_normals: bool,
+        /// Which mesh of a `.serialized` file (Mitsuba's `shape_index`); 0 for other files.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        shape_index: u32,
     },
     /// A mesh of [`SceneDesc::meshes`] placed by its transform (shared, not copied).
     Instance {
@@ -232,6 +235,10 @@ pub enum Geometry {
     Cube,
     /// The unit disk in the z = 0 plane, facing +z.
     Disk,
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

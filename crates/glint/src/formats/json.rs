@@ -595,7 +595,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         let geometry = match s.kind.as_str() {
             "obj" | "ply" => {
                 let file = s.file.as_ref().ok_or_else(|| here("needs 'file'".into()))?;
-                Geometry::MeshFile { file: ctx.resolve(file), face_normals: s.face_normals }
+                Geometry::MeshFile { file: ctx.resolve(file), face_normals: s.face_normals, shape_index: 0 }
             }
             "instance" => {
                 let name = s.mesh.as_ref().ok_or_else(|| here("needs 'mesh'".into()))?;

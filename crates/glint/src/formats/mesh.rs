@@ -28,7 +28,7 @@ pub fn describe(path: &Path) -> Result<SceneDesc, Error> {
         loc: loc.clone(),
     });
     d.shapes.push(ShapeDesc {
-        geometry: Geometry::MeshFile { file: path.to_path_buf(), face_normals: false },
+        geometry: Geometry::MeshFile { file: path.to_path_buf(), face_normals: false, shape_index: 0 },
         to_world: IDENTITY,
         material: MaterialRef::Index(0),
         use_mtl: false,

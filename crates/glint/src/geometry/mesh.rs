@@ -237,33 +237,18 @@ pub fn quad_mesh(p: [Vec3; 4], split: BvhSplit) -> TriangleMesh {
     TriangleMesh::new(p.to_vec(), None, Some(uvs), vec![[0, 1, 2], [0, 2, 3]], split).expect("valid quad")
 }
 
-/// Axis-aligned cube [-1, 1]^3 with outward faces (Mitsuba's `cube`), 24 vertices so that
-/// each face has its own uv square.
+/// Axis-aligned cube [-1, 1]^3 with outward faces: Mitsuba's `cube`, vertex for vertex (24
+/// vertices, four per face, each face with its own uv square laid out as Mitsuba lays it, so
+/// that a texture on a cube lands where Mitsuba puts it).
 pub fn cube_mesh(split: BvhSplit) -> TriangleMesh {
-    let mut positions = Vec::new();
-    let mut uvs = Vec::new();
-    let mut indices = Vec::new();
-    // Each face: normal axis, sign; two tangent axes chosen so (t1 x t2) = outward normal.
-    for axis in 0..3 {
-        for sign in [-1.0f32, 1.0] {
-            let mut n = [0.0f32; 3];
-            n[axis] = sign;
-            let n = Vec3::from_array(n);
-            let t1 = Vec3::from_array({
-                let mut t = [0.0f32; 3];
-                t[(axis + 1) % 3] = 1.0;
-                t
-            });
-            let t2 = n.cross(t1);
-            let base = positions.len() as u32;
-            for (u, v) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                positions.push(n + t1 * u + t2 * v);
-                uvs.push([(u + 1.0) * 0.5, (v + 1.0) * 0.5]);
-            }
-            indices.push([base, base + 1, base + 2]);
-            indices.push([base, base + 2, base + 3]);
-        }
-    }
+    // Face s has the vertices 4s..4s+3 at these corners, corner c at (+-1, +-1, +-1) with
+    // bit k of c the sign of axis k, and uv (0, 1), (1, 1), (1, 0), (0, 0) in that order.
+    const CORNER: [u32; 24] = [1, 5, 4, 0, 3, 2, 6, 7, 1, 3, 7, 5, 5, 7, 6, 4, 4, 6, 2, 0, 3, 1, 0, 2];
+    const UV: [[f32; 2]; 4] = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+    let sign = |c: u32, k: u32| if c & (1 << k) != 0 { 1.0 } else { -1.0 };
+    let positions = CORNER.iter().map(|&c| Vec3 { x: sign(c, 0), y: sign(c, 1), z: sign(c, 2) }).collect();
+    let uvs = (0..24).map(|i| UV[i % 4]).collect();
+    let indices = (0..6u32).flat_map(|s| [[4 * s, 4 * s + 1, 4 * s + 2], [4 * s + 3, 4 * s, 4 * s + 2]]).collect();
     TriangleMesh::new(positions, None, Some(uvs), indices, split).expect("valid cube")
 }
 

@@ -4,6 +4,7 @@ pub mod image_io;
 pub mod layers;
 pub mod obj;
 pub mod ply;
+pub mod serialized;
 mod texture_file;
 
 pub use image_io::{read_image, write_image, Image};

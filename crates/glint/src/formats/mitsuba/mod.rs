@@ -5,6 +5,7 @@
 //! an error that names the plugin, the file and the line.
 
 mod props;
+mod spectrum;
 pub mod xml;
 
 use super::Define;
@@ -19,6 +20,7 @@ use crate::materials::conductor_preset;
 use crate::math::{Rgb, Transform, Vec3};
 use crate::sampling::{PixelFilter, SamplerKind};
 use props::{color_of, Props};
+use spectrum::SpectrumUse;
 use std::collections::HashMap;
 use std::path::Path;
 use xml::Element;
@@ -62,17 +64,22 @@ struct Reader<'a> {
     shapes: Vec<ShapeDesc>,
     lights: Vec<LightDesc>,
     warnings: Vec<String>,
+    /// Errors found so far: a scene's unsupported features are all reported, one a line.
+    errors: Vec<Error>,
+    /// The scene's tree, for resolving file names through its search path.
+    tree: &'a xml::SceneTree,
+    source: xml::IncludeSource<'a>,
 }
 
 pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    describe_tree(path, xml::load_tree(path, &defines)?)
+    describe_tree(path, &xml::load_tree(path, &defines)?, xml::IncludeSource::Disk)
 }
 
 /// Reads a Mitsuba scene given as text (for fuzzing and in-memory scenes); `path` names it.
 pub fn read_str(text: &str, path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    describe_tree(path, xml::load_tree_str(text, path, &defines, xml::IncludeSource::Disk)?)
+    describe_tree(path, &xml::load_tree_str(text, path, &defines, xml::IncludeSource::Disk)?, xml::IncludeSource::Disk)
 }
 
 /// [`read_str`] with `<include>`s read from `files` (path to text) instead of the disk: a
@@ -84,18 +91,22 @@ pub fn read_str_with_includes(
     files: &HashMap<std::path::PathBuf, String>,
 ) -> Result<SceneDesc, Error> {
     let defines: Vec<(String, String)> = defines.iter().map(|d| (d.name.clone(), d.value.clone())).collect();
-    describe_tree(path, xml::load_tree_str(text, path, &defines, xml::IncludeSource::Memory(files))?)
+    let source = xml::IncludeSource::Memory(files);
+    describe_tree(path, &xml::load_tree_str(text, path, &defines, source)?, source)
 }
 
-fn describe_tree(path: &Path, tree: xml::SceneTree) -> Result<SceneDesc, Error> {
-    let root = tree.root;
+fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::IncludeSource<'a>) -> Result<SceneDesc, Error> {
+    let root = &tree.root;
     let mut r = Reader {
+        tree,
+        source,
         named: HashMap::new(),
         material_index: HashMap::new(),
         materials: Vec::new(),
         shapes: Vec::new(),
         lights: Vec::new(),
         warnings: Vec::new(),
+        errors: Vec::new(),
     };
     for c in &root.children {
         if let Some(id) = c.attr("id") {
@@ -106,31 +117,41 @@ fn describe_tree(path: &Path, tree: xml::SceneTree) -> Result<SceneDesc, Error> 
     }
     let mut sensor = None;
     let mut integrator_el = None;
+    // Each object that fails adds its error and the reader goes on, so that one run reports
+    // every unsupported feature of the scene.
     for c in &root.children {
-        match c.tag.as_str() {
-            "shape" => r.shape(c)?,
-            "emitter" => r.emitter(c)?,
-            "sensor" => sensor = Some(c),
-            "integrator" => integrator_el = Some(c),
-            // Named BSDFs and textures are described when a shape refers to them.
-            "bsdf" | "texture" => {}
-            "medium" | "phase" | "volume" => {
-                return Err(c.err(format!("<{}> (participating media) is not supported", c.tag)))
+        let result = match c.tag.as_str() {
+            "shape" => r.shape(c),
+            "emitter" => r.emitter(c),
+            "sensor" => {
+                sensor = Some(c);
+                Ok(())
             }
-            other => return Err(c.err(format!("unexpected element <{other}> in <scene>"))),
-        }
+            "integrator" => {
+                integrator_el = Some(c);
+                Ok(())
+            }
+            // Named BSDFs and textures are described when a shape refers to them, samplers
+            // and films when the sensor does (an unreferenced one is ignored, as by Mitsuba).
+            "bsdf" | "texture" | "sampler" | "film" => Ok(()),
+            "medium" | "phase" | "volume" => {
+                Err(c.err(format!("<{}> (participating media) is not supported", c.tag)))
+            }
+            other => Err(c.err(format!("unexpected element <{other}> in <scene>"))),
+        };
+        r.note(result);
     }
-    let sensor = sensor.ok_or_else(|| Error::at(&SourceLoc::file(path), "the scene has no <sensor>"))?;
-    let (camera, film, seed) = r.sensor(sensor)?;
-    let integrator = match integrator_el {
-        Some(e) => r.integrator(e)?,
-        None => IntegratorDesc::Path(PathSettings::default()),
-    };
+    let described = r.describe_sensor(path, sensor, integrator_el);
+    let described = r.note(described);
+    if let Some(e) = Error::many(std::mem::take(&mut r.errors)) {
+        return Err(e);
+    }
+    let (camera, film, seed, spp, integrator) = described.expect("no errors, so described");
     let mut desc = SceneDesc::empty(camera, film);
     desc.source = Some(path.to_path_buf());
-    desc.includes = tree.included;
+    desc.includes = tree.included.clone();
     desc.integrator = integrator;
-    desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp: settings_spp(sensor)?.unwrap_or(16), seed };
+    desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp, seed };
     desc.materials = r.materials;
     desc.shapes = r.shapes;
     desc.lights = r.lights;
@@ -138,8 +159,60 @@ fn describe_tree(path: &Path, tree: xml::SceneTree) -> Result<SceneDesc, Error> 
     Ok(desc)
 }
 
-fn settings_spp(sensor: &Element) -> Result<Option<u32>, Error> {
-    if let Some(c) = sensor.children.iter().find(|c| c.tag == "sampler") {
+impl<'a> Reader<'a> {
+    /// The most errors one run reports.
+    const MAX_ERRORS: usize = 100;
+
+    /// Keeps an error (once: a BSDF shared by several shapes fails once) and goes on.
+    fn note<T>(&mut self, result: Result<T, Error>) -> Option<T> {
+        match result {
+            Ok(v) => Some(v),
+            Err(e) => {
+                if self.errors.len() < Self::MAX_ERRORS && !self.errors.contains(&e) {
+                    self.errors.push(e);
+                } else if self.errors.len() == Self::MAX_ERRORS {
+                    self.errors.push(Error::new(format!("(more errors; the first {} are shown)", Self::MAX_ERRORS)));
+                }
+                None
+            }
+        }
+    }
+
+    /// The camera, film, seed, samples per pixel and integrator.
+    #[allow(clippy::type_complexity)]
+    fn describe_sensor(
+        &mut self,
+        path: &Path,
+        sensor: Option<&'a Element>,
+        integrator_el: Option<&'a Element>,
+    ) -> Result<(CameraDesc, FilmDesc, u64, u32, IntegratorDesc), Error> {
+        let root = &self.tree.root;
+        let sensor = sensor.ok_or_else(|| Error::at(&SourceLoc::file(path), "the scene has no <sensor>"))?;
+        let sampler_el = self.sensor_child(sensor, "sampler")?;
+        let film_el = self.sensor_child(sensor, "film")?;
+        for c in &root.children {
+            let used = [sampler_el, film_el].iter().flatten().any(|u| std::ptr::eq(*u, c));
+            if matches!(c.tag.as_str(), "sampler" | "film") && !used {
+                self.warnings.push(
+                    c.err(format!(
+                        "<{}> at scene level is not used by the sensor (it would need a <ref id> there) and was ignored, as Mitsuba ignores it",
+                        c.tag
+                    ))
+                    .to_string(),
+                );
+            }
+        }
+        let (camera, film, seed) = self.sensor(sensor, film_el, sampler_el)?;
+        let integrator = match integrator_el {
+            Some(e) => self.integrator(e)?,
+            None => IntegratorDesc::Path(PathSettings::default()),
+        };
+        Ok((camera, film, seed, settings_spp(sampler_el)?.unwrap_or(16), integrator))
+    }
+}
+
+fn settings_spp(sampler: Option<&Element>) -> Result<Option<u32>, Error> {
+    if let Some(c) = sampler {
         let p = Props::new(c);
         let n = p.int("sample_count", 4)?;
         let max = crate::describe::limits::MAX_SPP as i64;
@@ -157,6 +230,12 @@ fn matrix(t: &Transform) -> crate::describe::Matrix4 {
 
 impl<'a> Reader<'a> {
     fn warn_unused(&mut self, p: &Props) {
+        for c in &p.el.children {
+            let medium = c.tag == "medium" || (c.tag == "ref" && self.resolve(c).is_ok_and(|t| t.tag == "medium"));
+            if medium {
+                self.note::<()>(Err(c.err("<medium> (participating media) is not supported")));
+            }
+        }
         for (name, line) in p.unused() {
             self.warnings.push(format!(
                 "{}:{}: <{} type=\"{}\">: parameter '{name}' is not supported and was ignored",
@@ -166,6 +245,11 @@ impl<'a> Reader<'a> {
                 p.el.attr("type").unwrap_or("")
             ));
         }
+    }
+
+    /// A plugin's `filename`, found through the scene's search path (`<path>`).
+    fn resolve_file(&self, el: &Element, name: &str) -> std::path::PathBuf {
+        self.tree.resolve(el, name, self.source)
     }
 
     /// Follows `<ref id>` to the named object.
@@ -185,7 +269,7 @@ impl<'a> Reader<'a> {
         let Some(e) = p.find(name) else { return Ok(TextureDesc::constant(default)) };
         let e = self.resolve(e)?;
         if e.tag != "texture" {
-            return Ok(TextureDesc::constant(color_of(e)?));
+            return Ok(TextureDesc::constant(color_of(e, SpectrumUse::Reflectance)?));
         }
         let tp = Props::new(e);
         let to_uv = tp.transform("to_uv")?;
@@ -197,7 +281,7 @@ impl<'a> Reader<'a> {
         match e.attr("type").unwrap_or("") {
             "bitmap" => {
                 let file = tp.string("filename").ok_or_else(|| e.err("bitmap texture needs 'filename'"))?;
-                let path = e.file.parent().unwrap_or(Path::new(".")).join(file);
+                let path = self.resolve_file(e, file);
                 let raw = tp.bool("raw", false)?;
                 let _ = tp.string("filter_type");
                 let _ = tp.string("wrap_mode");
@@ -244,7 +328,10 @@ impl<'a> Reader<'a> {
     fn conductor_ior(&self, p: &Props) -> Result<(Rgb, Rgb), Error> {
         let (eta_el, k_el) = (p.find("eta"), p.find("k"));
         if eta_el.is_some() || k_el.is_some() {
-            return Ok((p.rgb("eta", Rgb::BLACK)?, p.rgb("k", Rgb::WHITE)?));
+            return Ok((
+                p.rgb_as("eta", Rgb::BLACK, SpectrumUse::Unbounded)?,
+                p.rgb_as("k", Rgb::WHITE, SpectrumUse::Unbounded)?,
+            ));
         }
         let name = p.string("material").unwrap_or("none");
         conductor_preset(name)
@@ -320,37 +407,41 @@ impl<'a> Reader<'a> {
         // BSDF: a nested <bsdf> or a <ref> to one.
         let mut material = None;
         let mut emission = None;
+        // Each child's error is kept and the next child read, so that a shape with several
+        // unsupported features reports them all.
+        let errors_before = self.errors.len();
         for c in &el.children {
-            match c.tag.as_str() {
-                "bsdf" => material = Some(self.material(c)?),
-                "ref" => {
-                    let target = self.resolve(c)?;
-                    match target.tag.as_str() {
-                        "bsdf" => material = Some(self.material(target)?),
-                        other => return Err(c.err(format!("a shape cannot refer to a <{other}>"))),
-                    }
-                }
-                "emitter" => {
-                    if c.attr("type") != Some("area") {
-                        return Err(c.err(format!(
-                            "emitter '{}' cannot be attached to a shape (only 'area')",
-                            c.attr("type").unwrap_or("")
-                        )));
-                    }
-                    let ep = Props::new(c);
-                    emission = Some(Emission { radiance: ep.rgb("radiance", Rgb::WHITE)?, two_sided: false });
-                    self.warn_unused(&ep);
-                }
-                "medium" => return Err(c.err("<medium> (participating media) is not supported")),
-                _ => {}
-            }
+            let result = match c.tag.as_str() {
+                "bsdf" => self.material(c).map(|m| material = Some(m)),
+                "ref" => self.resolve(c).and_then(|target| match target.tag.as_str() {
+                    "bsdf" => self.material(target).map(|m| material = Some(m)),
+                    "medium" => Err(c.err("<medium> (participating media) is not supported")),
+                    other => Err(c.err(format!("a shape cannot refer to a <{other}>"))),
+                }),
+                "emitter" => self.area_emitter(c).map(|e| emission = Some(e)),
+                "medium" => Err(c.err("<medium> (participating media) is not supported")),
+                _ => Ok(()),
+            };
+            self.note(result);
         }
         let material = material.map_or(MaterialRef::DefaultDiffuse, MaterialRef::Index);
         let geometry = match ty {
             "obj" | "ply" => {
                 let file = p.string("filename").ok_or_else(|| el.err(format!("shape '{ty}' needs 'filename'")))?;
-                let path = el.file.parent().unwrap_or(Path::new(".")).join(file);
-                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)? }
+                let path = self.resolve_file(el, file);
+                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)?, shape_index: 0 }
+            }
+            "serialized" => {
+                let file = p.string("filename").ok_or_else(|| el.err("shape 'serialized' needs 'filename'"))?;
+                let path = self.resolve_file(el, file);
+                if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("serialized")) {
+                    return Err(el.err(format!("serialized: glint reads these meshes from .serialized files, not '{file}'")));
+                }
+                let index = p.int("shape_index", 0)?;
+                if !(0..=u32::MAX as i64).contains(&index) {
+                    return Err(el.err(format!("serialized: shape_index {index} must be 0 or more")));
+                }
+                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)?, shape_index: index as u32 }
             }
             "sphere" => {
                 Geometry::Sphere { center: p.point("center")?.unwrap_or(Vec3::ZERO), radius: p.float("radius", 1.0)? }
@@ -361,6 +452,9 @@ impl<'a> Reader<'a> {
             other => return Err(el.err(format!("shape plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
+        if self.errors.len() > errors_before {
+            return Ok(());
+        }
         self.shapes.push(ShapeDesc {
             geometry,
             to_world: matrix(&to_world),
@@ -373,6 +467,19 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
+    fn area_emitter(&mut self, c: &'a Element) -> Result<Emission, Error> {
+        if c.attr("type") != Some("area") {
+            return Err(c.err(format!(
+                "emitter '{}' cannot be attached to a shape (only 'area')",
+                c.attr("type").unwrap_or("")
+            )));
+        }
+        let ep = Props::new(c);
+        let emission = Emission { radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?, two_sided: false };
+        self.warn_unused(&ep);
+        Ok(emission)
+    }
+
     fn emitter(&mut self, el: &'a Element) -> Result<(), Error> {
         let p = Props::new(el);
         let to_world = p.transform("to_world")?;
@@ -382,7 +489,7 @@ impl<'a> Reader<'a> {
                     Some(v) => v,
                     None => to_world.point(Vec3::ZERO),
                 },
-                intensity: p.rgb("intensity", Rgb::WHITE)?,
+                intensity: p.rgb_as("intensity", Rgb::WHITE, SpectrumUse::Emission)?,
             },
             "spot" => {
                 if p.find("texture").is_some() {
@@ -392,7 +499,7 @@ impl<'a> Reader<'a> {
                 LightKind::Spot {
                     position: to_world.point(Vec3::ZERO),
                     direction: to_world.vector(Vec3::Z),
-                    intensity: p.rgb("intensity", Rgb::WHITE)?,
+                    intensity: p.rgb_as("intensity", Rgb::WHITE, SpectrumUse::Emission)?,
                     cutoff_degrees: cutoff,
                     beam_degrees: p.float("beam_width", cutoff * 0.75)?,
                 }
@@ -402,13 +509,13 @@ impl<'a> Reader<'a> {
                     Some(v) => v,
                     None => to_world.vector(Vec3::Z),
                 },
-                irradiance: p.rgb("irradiance", Rgb::WHITE)?,
+                irradiance: p.rgb_as("irradiance", Rgb::WHITE, SpectrumUse::Emission)?,
             },
-            "constant" => LightKind::Constant { radiance: p.rgb("radiance", Rgb::WHITE)? },
+            "constant" => LightKind::Constant { radiance: p.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)? },
             "envmap" => {
                 let file = p.string("filename").ok_or_else(|| el.err("envmap needs 'filename'"))?;
                 LightKind::EnvMap {
-                    file: el.file.parent().unwrap_or(Path::new(".")).join(file),
+                    file: self.resolve_file(el, file),
                     scale: p.float("scale", 1.0)?,
                     to_world: matrix(&to_world),
                 }
@@ -421,8 +528,29 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
+    /// The sensor's `<film>` or `<sampler>`: nested, or a `<ref id>` to one at scene level
+    /// (Mitsuba accepts both); two are an error, as in Mitsuba.
+    fn sensor_child(&self, sensor: &'a Element, tag: &str) -> Result<Option<&'a Element>, Error> {
+        let mut found = None;
+        for c in &sensor.children {
+            let target = if c.tag == "ref" { self.resolve(c)? } else { c };
+            if target.tag == tag {
+                if found.is_some() {
+                    return Err(c.err(format!("only one <{tag}> can be given per sensor")));
+                }
+                found = Some(target);
+            }
+        }
+        Ok(found)
+    }
+
     /// The camera, the film and the sampler's seed.
-    fn sensor(&mut self, el: &'a Element) -> Result<(CameraDesc, FilmDesc, u64), Error> {
+    fn sensor(
+        &mut self,
+        el: &'a Element,
+        film_el: Option<&'a Element>,
+        sampler_el: Option<&'a Element>,
+    ) -> Result<(CameraDesc, FilmDesc, u64), Error> {
         let ty = el.attr("type").unwrap_or("");
         if ty != "perspective" && ty != "thinlens" {
             return Err(el.err(format!("sensor plugin '{ty}' is not supported (perspective, thinlens)")));
@@ -444,7 +572,6 @@ impl<'a> Reader<'a> {
             None if p.opt_float("fov")?.is_some() => FovAxis::X,
             None => FovAxis::Diagonal,
         };
-        let film_el = el.children.iter().find(|c| c.tag == "film");
         let mut film =
             FilmDesc { width: 768, height: 576, filter: PixelFilter::Gaussian { stddev: 0.5 }, loc: el.loc() };
         if let Some(f) = film_el {
@@ -501,7 +628,7 @@ impl<'a> Reader<'a> {
             }
         }
         let mut seed = 0;
-        if let Some(s) = el.children.iter().find(|c| c.tag == "sampler") {
+        if let Some(s) = sampler_el {
             let sp = Props::new(s);
             let v = sp.int("seed", 0)?;
             if v < 0 {

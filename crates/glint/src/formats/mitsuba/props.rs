@@ -3,6 +3,7 @@
 //! Every read marks the parameter as used, so that misspelt or unsupported parameters can
 //! be reported instead of silently ignored.
 
+use super::spectrum::{self, SpectrumUse};
 use super::xml::Element;
 use crate::error::Error;
 use crate::math::{Mat4, Rgb, Transform, Vec3};
@@ -89,11 +90,16 @@ impl<'a> Props<'a> {
         self.find(name).and_then(|e| e.attr("value"))
     }
 
-    /// A colour from `<rgb>`, a constant `<spectrum>` or a `<float>`.
+    /// A reflectance-like colour from `<rgb>`, `<spectrum>` or `<float>`.
     pub fn rgb(&self, name: &str, default: Rgb) -> Result<Rgb, Error> {
+        self.rgb_as(name, default, SpectrumUse::Reflectance)
+    }
+
+    /// A colour, spectra converted for `usage` (an emitter's radiance, a conductor's eta).
+    pub fn rgb_as(&self, name: &str, default: Rgb, usage: SpectrumUse) -> Result<Rgb, Error> {
         match self.find(name) {
             None => Ok(default),
-            Some(e) => color_of(e),
+            Some(e) => color_of(e, usage),
         }
     }
 
@@ -126,7 +132,9 @@ impl<'a> Props<'a> {
     }
 }
 
-pub fn color_of(e: &Element) -> Result<Rgb, Error> {
+/// A colour from `<rgb>` (1 or 3 numbers), `<float>` or `<spectrum>`, spectra converted to
+/// RGB as Mitsuba's RGB variants convert them for `usage` (see [`super::spectrum`]).
+pub fn color_of(e: &Element, usage: SpectrumUse) -> Result<Rgb, Error> {
     match e.tag.as_str() {
         "rgb" => {
             let f = parse_floats(e, e.required("value")?)?;
@@ -136,20 +144,89 @@ pub fn color_of(e: &Element) -> Result<Rgb, Error> {
                 _ => Err(e.err("an <rgb> value needs 1 or 3 numbers")),
             }
         }
-        "spectrum" => {
-            let v = e.required("value")?;
-            if v.contains(':') {
-                return Err(e.err("sampled spectra (wavelength:value lists) are not supported; give an <rgb>"));
-            }
-            let f = parse_floats(e, v)?;
-            if f.len() != 1 {
-                return Err(e.err("a <spectrum> must be a single constant value (or use <rgb>)"));
-            }
-            Ok(Rgb::splat(f[0]))
-        }
+        "spectrum" => spectrum_of(e, usage),
         "float" => Ok(Rgb::splat(parse_float(e, e.required("value")?)?)),
         other => Err(e.err(format!("expected a colour (<rgb>, <spectrum> or <float>), found <{other}>"))),
     }
+}
+
+/// The most wavelength:value pairs one `<spectrum>` may list.
+pub const MAX_SPECTRUM_SAMPLES: usize = 100_000;
+
+fn spectrum_of(e: &Element, usage: SpectrumUse) -> Result<Rgb, Error> {
+    if let Some(ty) = e.attr("type") {
+        let p = Props::new(e);
+        let finite = |name: &str, v: f32| {
+            if v.is_finite() {
+                Ok(v as f64)
+            } else {
+                Err(e.err(format!("<spectrum type=\"{ty}\">: '{name}' must be finite")))
+            }
+        };
+        let rgb = match ty {
+            "blackbody" => {
+                if p.find("temperature").is_none() {
+                    return Err(e.err("<spectrum type=\"blackbody\"> needs a 'temperature'"));
+                }
+                let t = finite("temperature", p.float("temperature", 0.0)?)?;
+                let lo = finite("wavelength_min", p.float("wavelength_min", 360.0)?)?;
+                let hi = finite("wavelength_max", p.float("wavelength_max", 830.0)?)?;
+                if !(t > 0.0) {
+                    return Err(e.err(format!("blackbody temperature {t} must be positive (kelvin)")));
+                }
+                if !(lo < hi) {
+                    return Err(e.err("blackbody: wavelength_min must be below wavelength_max"));
+                }
+                spectrum::blackbody_to_rgb(t, lo, hi)
+            }
+            "uniform" => Rgb::splat(p.float("value", 1.0)?),
+            "srgb" => p.rgb("color", Rgb::WHITE)?,
+            other => {
+                return Err(e.err(format!(
+                    "spectrum plugin '{other}' is not supported (blackbody, uniform, srgb; give other spectra as value=\"wavelength:value, ...\")"
+                )))
+            }
+        };
+        if let Some((name, line)) = p.unused().first() {
+            return Err(Error::at(
+                &crate::error::SourceLoc::new(e.file.as_path(), *line as u32, 0),
+                format!("<spectrum type=\"{ty}\"> has no parameter '{name}'"),
+            ));
+        }
+        return Ok(rgb);
+    }
+    if e.attr("filename").is_some() {
+        return Err(e.err("spectra read from files (<spectrum filename>) are not supported; give value=\"wavelength:value, ...\""));
+    }
+    let v = e.required("value")?;
+    let tokens: Vec<&str> = v.split(|c: char| c == ',' || c.is_whitespace()).filter(|t| !t.is_empty()).collect();
+    if tokens.len() == 1 && !tokens[0].contains(':') {
+        let x = parse_float(e, tokens[0])?;
+        return Ok(spectrum::constant_to_rgb(x as f64, usage));
+    }
+    if tokens.len() > MAX_SPECTRUM_SAMPLES {
+        return Err(e.err(format!("a <spectrum> may list at most {MAX_SPECTRUM_SAMPLES} wavelengths")));
+    }
+    let mut wavelengths = Vec::with_capacity(tokens.len());
+    let mut values = Vec::with_capacity(tokens.len());
+    for t in &tokens {
+        let (w, x) = t.split_once(':').ok_or_else(|| e.err(format!("'{t}' is not a wavelength:value pair")))?;
+        let num = |s: &str| -> Result<f64, Error> {
+            match s.trim().parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(e.err(format!("'{t}' is not a wavelength:value pair of finite numbers"))),
+            }
+        };
+        wavelengths.push(num(w)?);
+        values.push(num(x)?);
+    }
+    if wavelengths.len() < 2 {
+        return Err(e.err("a sampled <spectrum> needs at least two wavelength:value pairs"));
+    }
+    if wavelengths.windows(2).any(|p| p[1] <= p[0]) {
+        return Err(e.err("the wavelengths of a <spectrum> must increase"));
+    }
+    Ok(spectrum::list_to_rgb(&wavelengths, &values, usage))
 }
 
 /// Composes the operations of a `<transform>` in document order (each applies after the

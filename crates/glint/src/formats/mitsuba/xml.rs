@@ -22,6 +22,9 @@ pub struct Element {
     pub file: Arc<PathBuf>,
     pub line: usize,
     pub col: usize,
+    /// For an element of an included file: the folders that file's `<include>` and `<path>`
+    /// elements searched (see [`SceneTree::resolve`]); `None` in the scene file itself.
+    pub search: Option<Arc<Vec<PathBuf>>>,
 }
 
 impl Element {
@@ -49,10 +52,22 @@ pub enum IncludeSource<'a> {
 }
 
 impl IncludeSource<'_> {
-    fn exists(&self, path: &Path) -> bool {
+    /// Whether a file exists (in memory: is a key).
+    pub fn exists(&self, path: &Path) -> bool {
         match self {
-            IncludeSource::Disk => path.exists(),
-            IncludeSource::Memory(files) => files.contains_key(path),
+            IncludeSource::Disk => path.is_file(),
+            IncludeSource::Memory(files) => files.contains_key(&normalize(path)),
+        }
+    }
+
+    /// Whether a folder exists (in memory: some key lies under it).
+    pub fn dir_exists(&self, path: &Path) -> bool {
+        match self {
+            IncludeSource::Disk => path.is_dir(),
+            IncludeSource::Memory(files) => {
+                let path = normalize(path);
+                files.keys().any(|k| k.starts_with(&path) && *k != path)
+            }
         }
     }
 
@@ -60,12 +75,30 @@ impl IncludeSource<'_> {
     fn parse(&self, path: &Path) -> Result<Element, Error> {
         match self {
             IncludeSource::Disk => parse_str(&crate::formats::read_text(path)?, path),
-            IncludeSource::Memory(files) => match files.get(path) {
+            IncludeSource::Memory(files) => match files.get(&normalize(path)) {
                 Some(text) => parse_str(text, path),
                 None => Err(Error::at(&SourceLoc::file(path), "file does not exist")),
             },
         }
     }
+}
+
+/// `a/./b/../c` as `a/c`, without the file system (for paths in memory).
+fn normalize(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !out.pop() {
+                    out.push("..");
+                }
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
 }
 
 pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
@@ -110,6 +143,7 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
                 file: file.clone(),
                 line: loc.line as usize,
                 col: loc.col as usize,
+                search: None,
             })
         };
         match ev {
@@ -158,6 +192,31 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
 pub struct SceneTree {
     pub root: Element,
     pub included: Vec<PathBuf>,
+    /// Mitsuba's search path for the files that plugins name (meshes, textures, ...): the
+    /// scene file's `<path>` folders, the last one first, then the scene file's own folder.
+    pub search: Vec<PathBuf>,
+}
+
+impl SceneTree {
+    /// The file that a plugin's relative `filename` names, found as Mitsuba finds it: in the
+    /// scene's search path ([`SceneTree::search`], wherever in the scene file the `<path>`
+    /// elements stand), and, for an element of an included file, failing that, in the folders
+    /// that included file searched (its own `<path>`s, its folder, the folders of the files
+    /// that included it: glint's addition, where Mitsuba would find nothing). A name found
+    /// nowhere is taken relative to the element's own file, for the error that follows.
+    pub fn resolve(&self, el: &Element, name: &str, source: IncludeSource<'_>) -> PathBuf {
+        let name = Path::new(name);
+        if name.is_absolute() {
+            return name.to_path_buf();
+        }
+        let scoped = el.search.as_deref().map_or(&[][..], |v| v.as_slice());
+        self.search
+            .iter()
+            .chain(scoped)
+            .map(|d| d.join(name))
+            .find(|p| source.exists(p))
+            .unwrap_or_else(|| el.file.parent().unwrap_or(Path::new(".")).join(name))
+    }
 }
 
 /// Loads a scene file: parses it, expands includes, applies version upgrades, collects
@@ -191,7 +250,8 @@ fn load_tree_from(mut root: Element, defines: &[(String, String)], source: Inclu
     if major > 3 {
         return Err(root.err(format!("scene version {version} is newer than the 3.x that glint reads")));
     }
-    expand_includes(&mut root, 0, &mut included, source)?;
+    let mut search = vec![root.file.parent().unwrap_or(Path::new(".")).to_path_buf()];
+    expand_includes(&mut root, 0, true, &mut search, &mut included, source)?;
     if major < 2 {
         upgrade_from_v0(&mut root);
     }
@@ -210,7 +270,7 @@ fn load_tree_from(mut root: Element, defines: &[(String, String)], source: Inclu
         values.insert(k.clone(), v.clone());
     }
     substitute(&mut root, &values)?;
-    Ok(SceneTree { root, included: included.files })
+    Ok(SceneTree { root, included: included.files, search })
 }
 
 /// The files included so far, and how many `<include>`s were expanded in all.
@@ -220,19 +280,56 @@ struct Includes {
     expanded: usize,
 }
 
-fn expand_includes(el: &mut Element, depth: usize, included: &mut Includes, source: IncludeSource<'_>) -> Result<(), Error> {
+/// Expands the `<include>`s under `el` and applies its `<path>`s, as Mitsuba's parser does:
+/// `search` is the search path in effect (most recent folder first). A `<path>` (allowed only
+/// as a child of a file's root, `at_root`) adds its folder in front, found relative to its
+/// file or else through the search path; an `<include>` is looked for in the including file's
+/// folder, then through the search path, and is expanded with a copy of the search path that
+/// starts with that folder, so that what the included file adds stays within it.
+fn expand_includes(
+    el: &mut Element,
+    depth: usize,
+    at_root: bool,
+    search: &mut Vec<PathBuf>,
+    included: &mut Includes,
+    source: IncludeSource<'_>,
+) -> Result<(), Error> {
     if depth > 16 {
         return Err(el.err("includes nested more than 16 deep (a cycle?)"));
     }
     let mut out = Vec::with_capacity(el.children.len());
     for mut c in std::mem::take(&mut el.children) {
-        if c.tag == "include" {
+        let dir = c.file.parent().unwrap_or(Path::new(".")).to_path_buf();
+        if c.tag == "path" {
+            if !at_root {
+                return Err(c.err("<path> may only be a child of the root <scene>"));
+            }
+            let value = c.required("value")?;
+            let given = Path::new(value);
+            let folder = if given.is_absolute() {
+                Some(given.to_path_buf())
+            } else {
+                std::iter::once(&dir).chain(search.iter()).map(|d| d.join(given)).find(|p| source.dir_exists(p))
+            };
+            match folder {
+                Some(f) if source.dir_exists(&f) => search.insert(0, f),
+                _ => return Err(c.err(format!("<path>: folder '{}' not found", dir.join(given).display()))),
+            }
+            if search.len() > MAX_INCLUDES {
+                return Err(c.err(format!("more than {MAX_INCLUDES} folders in the search path")));
+            }
+        } else if c.tag == "include" {
             included.expanded += 1;
             if included.expanded > MAX_INCLUDES {
                 return Err(c.err(format!("more than {MAX_INCLUDES} <include>s in one scene")));
             }
-            let name = c.required("filename")?;
-            let path = c.file.parent().unwrap_or(Path::new(".")).join(name);
+            let name = Path::new(c.required("filename")?);
+            let mut inner: Vec<PathBuf> = std::iter::once(dir.clone()).chain(search.iter().cloned()).collect();
+            let path = if name.is_absolute() {
+                name.to_path_buf()
+            } else {
+                inner.iter().map(|d| d.join(name)).find(|p| source.exists(p)).unwrap_or_else(|| dir.join(name))
+            };
             if !source.exists(&path) {
                 return Err(c.err(format!("included file '{}' does not exist", path.display())));
             }
@@ -240,19 +337,34 @@ fn expand_includes(el: &mut Element, depth: usize, included: &mut Includes, sour
             if !included.files.contains(&path) {
                 included.files.push(path.clone());
             }
-            expand_includes(&mut inc, depth + 1, included, source)?;
+            // The included file's folder comes first within it.
+            inner.insert(0, path.parent().unwrap_or(Path::new(".")).to_path_buf());
+            expand_includes(&mut inc, depth + 1, true, &mut inner, included, source)?;
+            let scope = Arc::new(inner);
+            set_search(&mut inc, &scope);
             if inc.tag == "scene" {
                 out.extend(inc.children);
             } else {
                 out.push(inc);
             }
         } else {
-            expand_includes(&mut c, depth, included, source)?;
+            expand_includes(&mut c, depth, false, search, included, source)?;
             out.push(c);
         }
     }
     el.children = out;
     Ok(())
+}
+
+/// Gives the elements of one included file (not those of files it included in turn, which
+/// have theirs already) the search path that file ended with.
+fn set_search(el: &mut Element, scope: &Arc<Vec<PathBuf>>) {
+    if el.search.is_none() {
+        el.search = Some(scope.clone());
+        for c in el.children.iter_mut() {
+            set_search(c, scope);
+        }
+    }
 }
 
 /// `sampleCount` to `sample_count`, `intIOR` to `int_ior`: a run of capitals is one word.
@@ -300,6 +412,95 @@ mod tests {
         assert_eq!(shape.children[0].attr("name"), Some("to_world"));
         assert_eq!(shape.children[0].children[0].tag, "lookat");
         assert_eq!(shape.children[1].attr("value"), Some("3"));
+    }
+
+    /// Files in memory under /m/, for the search-path tests.
+    fn memory(files: &[(&str, &str)]) -> HashMap<PathBuf, String> {
+        files.iter().map(|(k, v)| (PathBuf::from(format!("/m/{k}")), v.to_string())).collect()
+    }
+
+    fn shape_file(tree: &SceneTree, files: &HashMap<PathBuf, String>, i: usize) -> PathBuf {
+        let el = &tree.root.children[i];
+        let name = el.children.iter().find(|c| c.attr("name") == Some("filename")).unwrap().attr("value").unwrap();
+        normalize(&tree.resolve(el, name, IncludeSource::Memory(files)))
+    }
+
+    const OBJ: &str = "v 0 0 0";
+
+    /// As Mitsuba 3.9.1 resolves them (each case checked there): the scene file's <path>s,
+    /// wherever they stand and the last one first, then its folder; a <path> in an included
+    /// file is relative to that file (or found through the search path) and serves that file.
+    #[test]
+    fn path_adds_folders_to_the_search_path() {
+        let shape = |f: &str| format!(r#"<shape type="obj"><string name="filename" value="{f}"/></shape>"#);
+        // A <path> after the shape that uses it still applies; the last <path> wins.
+        let files = memory(&[("a/m.obj", OBJ), ("b/m.obj", OBJ), ("m.obj", OBJ), ("c/only.obj", OBJ)]);
+        let text = format!(
+            r#"<scene version="3.0.0">{}{}<path value="a"/><path value="/m/b"/><path value="c"/></scene>"#,
+            shape("m.obj"),
+            shape("only.obj")
+        );
+        let tree = load_tree_str(&text, Path::new("/m/scene.xml"), &[], IncludeSource::Memory(&files)).unwrap();
+        assert_eq!(tree.root.children.len(), 2, "the <path>s are not elements of the scene");
+        assert_eq!(shape_file(&tree, &files, 0), Path::new("/m/b/m.obj"));
+        assert_eq!(shape_file(&tree, &files, 1), Path::new("/m/c/only.obj"));
+        // Without <path>, the scene's folder.
+        let text = format!(r#"<scene version="3.0.0">{}</scene>"#, shape("m.obj"));
+        let tree = load_tree_str(&text, Path::new("/m/scene.xml"), &[], IncludeSource::Memory(&files)).unwrap();
+        assert_eq!(shape_file(&tree, &files, 0), Path::new("/m/m.obj"));
+    }
+
+    #[test]
+    fn path_in_an_included_file_is_relative_to_it() {
+        let shape = |f: &str| format!(r#"<shape type="obj"><string name="filename" value="{f}"/></shape>"#);
+        let files = memory(&[
+            // ../../common does not exist next to include/, but does through the search path
+            // (the scene's folder): Mitsuba's documentation scenes rely on this.
+            ("docs/scenes/include/part.xml", r#"<scene version="3.0.0"><path value="../../common"/><include filename="inner.xml"/></scene>"#),
+            ("common/inner.xml", &format!(r#"<scene version="3.0.0">{}</scene>"#, shape("mesh.obj"))),
+            ("common/mesh.obj", OBJ),
+            ("docs/common/.keep", ""),
+            // A <path> relative to the included file, used by the file it includes.
+            ("docs/scenes/sub/a.xml", r#"<scene version="3.0.0"><path value="assets"/><include filename="d.xml"/></scene>"#),
+            ("docs/scenes/sub/assets/d.xml", &format!(r#"<scene version="3.0.0">{}</scene>"#, shape("here.obj"))),
+            ("docs/scenes/sub/assets/here.obj", OBJ),
+        ]);
+        let text = r#"<scene version="3.0.0"><include filename="include/part.xml"/><include filename="sub/a.xml"/></scene>"#;
+        let main = Path::new("/m/docs/scenes/main.xml");
+        let err = load_tree_str(text, main, &[], IncludeSource::Memory(&files)).unwrap_err();
+        // /m/docs/common exists, so ../../common relative to include/ is that folder, in which
+        // inner.xml is not.
+        assert!(err.to_string().contains("inner.xml") && err.to_string().contains("does not exist"), "{err}");
+        let mut files = files;
+        files.remove(Path::new("/m/docs/common/.keep"));
+        let tree = load_tree_str(text, main, &[], IncludeSource::Memory(&files)).unwrap();
+        // Found through the included files' own search paths (Mitsuba finds neither: it looks
+        // for plugins' files in the scene file's search path only, which comes first here).
+        assert_eq!(shape_file(&tree, &files, 0), Path::new("/m/common/mesh.obj"));
+        assert_eq!(shape_file(&tree, &files, 1), Path::new("/m/docs/scenes/sub/assets/here.obj"));
+        // The scene file's search path comes first.
+        files.insert(PathBuf::from("/m/docs/scenes/here.obj"), OBJ.into());
+        let tree = load_tree_str(text, main, &[], IncludeSource::Memory(&files)).unwrap();
+        assert_eq!(shape_file(&tree, &files, 1), Path::new("/m/docs/scenes/here.obj"));
+        // An include found through the scene's <path>.
+        let text = r#"<scene version="3.0.0"><path value="sub"/><include filename="a.xml"/></scene>"#;
+        let tree = load_tree_str(text, main, &[], IncludeSource::Memory(&files)).unwrap();
+        assert_eq!(normalize(&tree.included[0]), Path::new("/m/docs/scenes/sub/a.xml"));
+    }
+
+    #[test]
+    fn path_errors() {
+        let files = memory(&[("x/y.obj", OBJ)]);
+        let load = |t: &str| load_tree_str(t, Path::new("/m/s.xml"), &[], IncludeSource::Memory(&files));
+        let e = load("<scene version=\"3.0.0\">\n<path value=\"nowhere\"/></scene>").unwrap_err().to_string();
+        assert!(e.contains("s.xml:2:") && e.contains("nowhere") && e.contains("not found"), "{e}");
+        let e = load("<scene version=\"3.0.0\"><shape type=\"obj\">\n<path value=\"x\"/></shape></scene>")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("s.xml:2:") && e.contains("child of the root"), "{e}");
+        let e = load("<scene version=\"3.0.0\"><path/></scene>").unwrap_err().to_string();
+        assert!(e.contains("'value'"), "{e}");
+        assert!(load("<scene version=\"3.0.0\"><path value=\"x\"/></scene>").is_ok());
     }
 
     #[test]
