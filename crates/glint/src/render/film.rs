@@ -690,10 +690,13 @@ mod tests {
 
     #[test]
     fn missing_is_what_a_pass_lacks() {
-        let full = Rect::full(8, 6);
-        let mut a = filled(Rect { x0: 0, y0: 0, x1: 4, y1: 3 }, 0..2, 1.0);
-        assert_eq!(a.missing(2), [full]);
+        let corner = Rect { x0: 0, y0: 0, x1: 4, y1: 3 };
+        let mut a = filled(corner, 0..2, 1.0);
+        assert_eq!(a.missing(2), [corner]);
+        assert!(a.missing(1).is_empty());
         a.merge(&filled(Rect { x0: 4, y0: 3, x1: 8, y1: 6 }, 0..1, 1.0)).unwrap();
+        // The merged film covers the whole image; nothing has pass 2 yet.
+        assert_eq!(a.missing(2), [Rect::full(8, 6)]);
         // Pass 0 lacks the other two quadrants, pass 1 three of them.
         assert_eq!(a.missing(0), [Rect { x0: 4, y0: 0, x1: 8, y1: 3 }, Rect { x0: 0, y0: 3, x1: 4, y1: 6 }]);
         assert_eq!(a.missing(1), [Rect { x0: 4, y0: 0, x1: 8, y1: 3 }, Rect { x0: 0, y0: 3, x1: 8, y1: 6 }]);
