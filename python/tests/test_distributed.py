@@ -152,8 +152,11 @@ def test_interrupted_then_resumed_by_the_cli_and_by_the_call(cluster, cli, tmp_p
     assert ck.exists() and out.exists()  # the image so far and the film
     local = tmp_path / "local.pfm"
     subprocess.run([str(cli), "render", str(scene), "-o", str(local), "--spp", "6", "--quiet"], check=True)
-    # glint resume fills in what the scattered blocks lack.
-    subprocess.run([str(cli), "resume", str(ck), "-o", str(tmp_path / "resumed.pfm"), "--quiet"], check=True)
+    # glint resume fills in what the scattered blocks lack (in a copy: it checkpoints into
+    # the film it resumes).
+    shutil.copy(ck, tmp_path / "copy.film")
+    subprocess.run([str(cli), "resume", str(tmp_path / "copy.film"), "-o", str(tmp_path / "resumed.pfm"), "--quiet"],
+                   check=True)
     assert (tmp_path / "resumed.pfm").read_bytes() == local.read_bytes()
     # The same call given the checkpoint renders only the rest; its output is the default.
     out.unlink()
