@@ -41,7 +41,10 @@ pub struct Session {
 type BlockTuple = ((u32, u32, u32, u32), (u32, u32));
 
 fn block_tuples(film: &Film) -> Vec<BlockTuple> {
-    film.blocks().iter().map(|b| ((b.region.x0, b.region.y0, b.region.x1, b.region.y1), (b.passes.start, b.passes.end))).collect()
+    film.blocks()
+        .iter()
+        .map(|b| ((b.region.x0, b.region.y0, b.region.x1, b.region.y1), (b.passes.start, b.passes.end)))
+        .collect()
 }
 
 /// Set when the render thread is done; the waiting thread sleeps on it.

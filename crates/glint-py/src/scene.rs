@@ -99,8 +99,8 @@ pub fn load_description(
     instanced: Vec<usize>,
 ) -> PyResult<Scene> {
     guard(|| {
-        let mut desc: SceneDesc = serde_json::from_str(json)
-            .map_err(|e| PyValueError::new_err(format!("not a scene description: {e}")))?;
+        let mut desc: SceneDesc =
+            serde_json::from_str(json).map_err(|e| PyValueError::new_err(format!("not a scene description: {e}")))?;
         desc.map_build_inputs(&mut |p| {
             files.get(p).cloned().ok_or_else(|| {
                 glint::Error::new(format!("{}: not among the files shipped with the scene", p.display()))

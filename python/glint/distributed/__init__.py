@@ -23,7 +23,7 @@ in flight, writes the image so far (and the checkpoint) and raises KeyboardInter
 import os
 import time
 from dataclasses import dataclass
-from typing import Any, Callable, List, Optional, Sequence, Union
+from typing import Any, Callable, List, Optional, Sequence, Tuple, Union
 
 from .. import RenderResult, Scene, load_file, make_session
 from . import _pack, _plan
@@ -166,7 +166,9 @@ def render(
         ray.init(address=address, include_dashboard=False, logging_level=logging.WARNING)
     try:
         options = _Options(tile, passes_per_task, cpus_per_task, max_retries, aovs, checkpoint_every)
-        results = _run(ray, frames, options, _callback(progress, report), started, load_seconds)
+        # Time to load and build the scene on the driver, and to start or reach Ray.
+        load = (load_seconds, time.perf_counter() - started - load_seconds)
+        results = _run(ray, frames, options, _callback(progress, report), started, load)
     finally:
         if own_ray:
             ray.shutdown()
@@ -198,7 +200,7 @@ def _callback(progress: Optional[Callable[[int, int], Any]], report: Optional[Ca
     return on_block
 
 
-def _run(ray: Any, frames: List[Frame], o: _Options, on_block: Any, started: float, load_seconds: float) -> list:
+def _run(ray: Any, frames: List[Frame], o: _Options, on_block: Any, started: float, load: Tuple[float, float]) -> list:
     from ._worker import render_block
 
     began = time.perf_counter()
@@ -232,7 +234,8 @@ def _run(ray: Any, frames: List[Frame], o: _Options, on_block: Any, started: flo
         stats.update(f.rays)
         stats.update(
             seconds=seconds,
-            load_seconds=load_seconds,
+            load_seconds=load[0],
+            ray_seconds=load[1],
             broadcast_seconds=broadcast_seconds,
             scene_bytes=f.pack.size,
             slots=slots,

@@ -52,7 +52,10 @@ class Bar:
         filled = int(40 * frac)
         bar = "█" * filled + "░" * (40 - filled)
         mrays = p.rays / max(p.elapsed, 1e-9) / 1e6
-        line = f"{_clock(p.elapsed)} {bar} {int(100 * frac):>3}% ETA {_eta(eta):>4} {p.spp_done}/{p.spp_total} spp, {mrays:.1f} Mrays/s"
+        line = (
+            f"{_clock(p.elapsed)} {bar} {int(100 * frac):>3}% ETA {_eta(eta):>4} "
+            f"{p.spp_done}/{p.spp_total} spp, {mrays:.1f} Mrays/s"
+        )
         sys.stderr.write("\r" + line)
         sys.stderr.flush()
 
@@ -127,10 +130,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     if not a.quiet:
         s = result.stats
         rays = s["rays"] + s["shadow_rays"]
-        render_s = s["seconds"] - s["load_seconds"]
+        # As glint render's "load": everything before the first task (here Ray's start too).
+        load_s = s["load_seconds"] + s["ray_seconds"]
+        render_s = s["seconds"] - load_s
         written = ", ".join(w for w in (a.output, a.checkpoint or a.resume) if w)
         print(
-            f"glint: {a.scene} {_size(result)} @ {result.spp} spp in {render_s:.3f} s (load {s['load_seconds']:.3f} s): "
+            f"glint: {a.scene} {_size(result)} @ {result.spp} spp in {render_s:.3f} s (load {load_s:.3f} s): "
             f"{rays / 1e6:.1f} M rays ({rays / max(render_s, 1e-9) / 1e6:.2f} Mrays/s), "
             f"{s['discarded_samples']} discarded samples -> {written}",
             file=sys.stderr,

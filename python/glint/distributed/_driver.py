@@ -86,7 +86,7 @@ class Driver:
         self.report = report
         self.in_flight: Dict[Any, Task] = {}
         self.totals = Totals()
-        self.samples_total = sum((t.region[2] - t.region[0]) * (t.region[3] - t.region[1]) * self._spp(t) for t in tasks)
+        self.samples_total = sum(_pixels(t) * self._spp(t) for t in tasks)
         self.samples_done = 0
         for t in tasks:
             frames[t.frame].tasks_left += 1
@@ -152,7 +152,7 @@ class Driver:
         self.totals.merge_seconds += time.perf_counter() - began
         if blocks != [(t.region, t.passes)]:
             raise RuntimeError(f"glint.distributed: task {t} returned the block {blocks}")
-        pixels = (t.region[2] - t.region[0]) * (t.region[3] - t.region[1])
+        pixels = _pixels(t)
         self.samples_done += pixels * self._spp(t)
         tot = self.totals
         tot.tasks += 1
@@ -179,6 +179,10 @@ class Driver:
             if f.checkpoint and f.dirty:
                 f.session.save_film(f.checkpoint, f.out)
                 f.dirty = False
+
+
+def _pixels(t: Task) -> int:
+    return (t.region[2] - t.region[0]) * (t.region[3] - t.region[1])
 
 
 def write_frame(f: Frame) -> None:

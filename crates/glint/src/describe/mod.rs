@@ -458,7 +458,12 @@ mod tests {
             two_sided: false,
             loc: SourceLoc::default(),
         });
-        d.meshes.push(MeshFileDesc { name: "m".into(), file: "bunny.ply".into(), face_normals: false, loc: SourceLoc::default() });
+        d.meshes.push(MeshFileDesc {
+            name: "m".into(),
+            file: "bunny.ply".into(),
+            face_normals: false,
+            loc: SourceLoc::default(),
+        });
         for file in ["box.obj", "bunny.ply"] {
             d.shapes.push(ShapeDesc {
                 geometry: Geometry::MeshFile { file: file.into(), face_normals: false },
