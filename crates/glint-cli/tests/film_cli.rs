@@ -111,6 +111,16 @@ fn contract(case: &Case, name: &str) {
     let regions = d.path("regions.pfm");
     ok(&["merge", &top, &bottom, "-o", &regions, "--quiet"]);
     same_file(&one, &regions);
+    // Scattered blocks (a region with fewer passes than the rest) merged into one film,
+    // which `resume` fills in: what a render farm's checkpoint holds.
+    let (tl, rest) = (d.path("tl.film"), d.path("rest.film"));
+    case.render(&d.path("tl.pfm"), 12, &["--crop", "0,0,40,11", "--passes", "0..5", "--film-out", &tl]);
+    case.render(&d.path("rest.pfm"), 12, &["--crop", "0,11,40,30", "--passes", "0..9", "--film-out", &rest]);
+    let scattered = d.path("scattered.film");
+    ok(&["merge", &tl, &rest, "-o", &d.path("scattered.pfm"), "--film-out", &scattered, "--quiet"]);
+    let resumed = d.path("resumed.pfm");
+    ok(&["resume", &scattered, "-o", &resumed, "--quiet"]);
+    same_file(&one, &resumed);
     // Overlapping work is refused.
     let e = fails(&["merge", &a, &a, "-o", &d.path("x.pfm")]);
     assert!(e.contains("a.film"), "{e}");

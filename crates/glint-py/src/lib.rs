@@ -15,6 +15,8 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<render::Session>()?;
     m.add_function(wrap_pyfunction!(scene::load_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_json, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::load_description, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::obj_material_files, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
     m.add("DEFAULT_PASS_SPP", glint::session::DEFAULT_PASS_SPP)?;

@@ -4,13 +4,16 @@
 use crate::convert::{guard, panic_message, scene_error};
 use crate::images::image_array;
 use crate::scene::Scene;
-use glint::render::{Aov, Film, RenderStats, Silent};
-use glint::session::{FilmOptions, RenderControl, RenderReport};
+use glint::error::SourceLoc;
+use glint::render::checkpoint::{decode_film, encode_film};
+use glint::render::{write_film, Aov, Film, FilmMeta, Rect, RenderStats, Silent};
+use glint::session::{read_film_and_job, FilmOptions, RenderControl, RenderJob, RenderReport};
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray3};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -29,6 +32,19 @@ pub struct Session {
     seed: u64,
     threads: Option<usize>,
     stats: RenderStats,
+    /// What checkpoints record beside the sums, for the output named: worked out once, as
+    /// it hashes every file of the scene.
+    meta: Option<(Option<PathBuf>, FilmMeta)>,
+}
+
+/// A film's blocks as ((x0, y0, x1, y1), (first pass, end pass)).
+type BlockTuple = ((u32, u32, u32, u32), (u32, u32));
+
+fn block_tuples(film: &Film) -> Vec<BlockTuple> {
+    film.blocks()
+        .iter()
+        .map(|b| ((b.region.x0, b.region.y0, b.region.x1, b.region.y1), (b.passes.start, b.passes.end)))
+        .collect()
 }
 
 /// Set when the render thread is done; the waiting thread sleeps on it.
@@ -69,8 +85,10 @@ fn add(total: &mut RenderStats, s: &RenderStats) {
 
 #[pymethods]
 impl Session {
+    /// `region` (x0, y0, x1, y1), x1 and y1 exclusive: the pixels this film holds (default
+    /// all), for a render farm's worker.
     #[new]
-    #[pyo3(signature = (scene, spp=None, seed=0, aovs=Vec::new(), threads=None))]
+    #[pyo3(signature = (scene, spp=None, seed=0, aovs=Vec::new(), threads=None, region=None))]
     fn new(
         py: Python<'_>,
         scene: Py<Scene>,
@@ -78,6 +96,7 @@ impl Session {
         seed: u64,
         aovs: Vec<String>,
         threads: Option<usize>,
+        region: Option<(u32, u32, u32, u32)>,
     ) -> PyResult<Session> {
         guard(|| {
             let aovs = aovs
@@ -89,28 +108,91 @@ impl Session {
             }
             let mut s = scene.borrow_mut(py);
             s.session.set_sampling(spp, Some(seed)).map_err(|e| scene_error(py, e))?;
+            let region = region.map(|(x0, y0, x1, y1)| Rect { x0, y0, x1, y1 });
             let film = s
                 .session
-                .new_film(&FilmOptions { pass_spp: None, region: None, aovs })
-                .map_err(|e| scene_error(py, e))?;
+                .new_film(&FilmOptions { pass_spp: None, region, aovs })
+                .map_err(|e| PyValueError::new_err(e.message))?;
             drop(s);
-            Ok(Session { scene, film, seed, threads, stats: RenderStats::default() })
+            Ok(Session { scene, film, seed, threads, stats: RenderStats::default(), meta: None })
         })
     }
 
-    /// Renders `passes` more passes (all that are left by default), stopping early at
-    /// `time_limit` seconds. `progress(done_spp, total_spp)` is called from this thread at
-    /// most four times a second and once at the end. Returns the passes rendered. Ctrl-C
-    /// raises KeyboardInterrupt within a pass's time, keeping the passes done.
-    #[pyo3(signature = (passes=None, time_limit=None, progress=None))]
+    /// Renders `passes` more passes (all that are left by default) from pass `first` (by
+    /// default the first the film lacks), stopping early at `time_limit` seconds.
+    /// `progress(done_spp, total_spp)` is called from this thread at most four times a
+    /// second and once at the end. Returns the passes rendered. Ctrl-C raises
+    /// KeyboardInterrupt within a pass's time, keeping the passes done.
+    #[pyo3(signature = (passes=None, time_limit=None, progress=None, first=None))]
     fn render_passes(
         &mut self,
         py: Python<'_>,
         passes: Option<u32>,
         time_limit: Option<f64>,
         progress: Option<Py<PyAny>>,
+        first: Option<u32>,
     ) -> PyResult<u32> {
-        guard(|| self.render_inner(py, passes, time_limit, progress))
+        guard(|| self.render_inner(py, passes, time_limit, progress, first))
+    }
+
+    /// The film as bytes in the checkpoint format (GLINTFLM), with no scene hash or
+    /// settings: a block that a render farm's worker sends back.
+    fn film_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        let bytes = py.detach(|| encode_film(&self.film, &FilmMeta::default()));
+        PyBytes::new(py, &bytes)
+    }
+
+    /// Adds a film given as bytes (`film_bytes` of a session of the same scene and
+    /// settings) to this one; returns its blocks. Films of another size, spp, pass size or
+    /// AOVs, and overlapping work, are refused (ValueError), leaving this film as it was.
+    fn merge_film(&mut self, py: Python<'_>, data: &[u8]) -> PyResult<Vec<BlockTuple>> {
+        guard(|| {
+            let film = &mut self.film;
+            py.detach(|| {
+                let (part, _) = decode_film(data)?;
+                film.merge(&part)?;
+                Ok(block_tuples(&part))
+            })
+            .map_err(|e: String| PyValueError::new_err(format!("merge_film: {e}")))
+        })
+    }
+
+    /// The film's blocks: ((x0, y0, x1, y1), (first pass, end pass)) for each, the pixels
+    /// and passes it holds.
+    fn blocks(&self) -> Vec<BlockTuple> {
+        block_tuples(&self.film)
+    }
+
+    /// Writes the film as a checkpoint (atomically) that `glint resume` continues, naming
+    /// `output` as the image to write.
+    #[pyo3(signature = (path, output=None))]
+    fn save_film(&mut self, py: Python<'_>, path: PathBuf, output: Option<PathBuf>) -> PyResult<()> {
+        guard(|| {
+            let meta = self.meta_for(py, output)?;
+            let film = &self.film;
+            py.detach(|| write_film(&path, film, &meta)).map_err(PyOSError::new_err)
+        })
+    }
+
+    /// Adds the checkpoint at `path` to this film; it must be of this scene and these
+    /// settings (SceneError otherwise, naming the file). Returns the output it names.
+    fn load_film(&mut self, py: Python<'_>, path: PathBuf) -> PyResult<Option<PathBuf>> {
+        guard(|| {
+            let (film, job, hash) = py.detach(|| read_film_and_job(&path)).map_err(|e| scene_error(py, e))?;
+            let mine = self.meta_for(py, None)?;
+            let loc = SourceLoc::file(&path);
+            let ours = RenderJob::from_json(&mine.settings).map_err(|e| scene_error(py, e))?;
+            if hash != mine.scene_hash {
+                let e = "the scene or a file it reads has changed since this film was written";
+                return Err(scene_error(py, glint::Error::at(&loc, e)));
+            }
+            if !job.same_render(&ours) {
+                let e = "the film was rendered with other settings (spp, seed, size, AOVs or scene edits)";
+                return Err(scene_error(py, glint::Error::at(&loc, e)));
+            }
+            self.film.merge(&film).map_err(|e| scene_error(py, glint::Error::at(&loc, e)))?;
+            Ok(job.output)
+        })
     }
 
     /// The image so far: float32 (height, width, 3), linear RGB.
@@ -184,12 +266,28 @@ impl Session {
 }
 
 impl Session {
+    /// The checkpoint metadata for `output`, with this session's sampling in the job.
+    fn meta_for(&mut self, py: Python<'_>, output: Option<PathBuf>) -> PyResult<FilmMeta> {
+        if let Some((o, m)) = &self.meta {
+            if *o == output {
+                return Ok(m.clone());
+            }
+        }
+        let mut scene = self.scene.try_borrow_mut(py)?;
+        scene.session.set_sampling(Some(self.film.spp()), Some(self.seed)).map_err(|e| scene_error(py, e))?;
+        let (session, film) = (&scene.session, &self.film);
+        let meta = py.detach(|| session.film_meta(film, output.as_deref())).map_err(|e| scene_error(py, e))?;
+        self.meta = Some((output, meta.clone()));
+        Ok(meta)
+    }
+
     fn render_inner(
         &mut self,
         py: Python<'_>,
         passes: Option<u32>,
         time_limit: Option<f64>,
         progress: Option<Py<PyAny>>,
+        first: Option<u32>,
     ) -> PyResult<u32> {
         let time_limit = match time_limit {
             Some(t) if !(t >= 0.0 && t.is_finite()) => {
@@ -197,7 +295,10 @@ impl Session {
             }
             t => t.map(Duration::from_secs_f64),
         };
-        let first = self.film.passes_done();
+        let first = first.unwrap_or(self.film.passes_done());
+        if first > self.film.pass_count() {
+            return Err(PyValueError::new_err(format!("first: pass {first} of {}", self.film.pass_count())));
+        }
         let end = match passes {
             Some(n) => first.saturating_add(n).min(self.film.pass_count()),
             None => self.film.pass_count(),

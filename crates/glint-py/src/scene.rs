@@ -1,7 +1,7 @@
 //! `Scene`: a loaded scene, its built world and mesh cache (a library session).
 
 use crate::convert::{guard, scene_error};
-use glint::describe::{Geometry, MeshData};
+use glint::describe::{Geometry, MeshData, SceneDesc};
 use glint::formats::{Define, ReadOptions};
 use glint::math::{Rgb, Vec3};
 use glint::session::{Param, ParamValue, Session};
@@ -9,6 +9,7 @@ use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 /// A loaded scene: its description and, once rendered, its built world. Made by
@@ -86,6 +87,39 @@ pub fn load_json(py: Python<'_>, text: &str, path: PathBuf, meshes: Vec<MeshArra
     })
 }
 
+/// Makes a scene from a description (`Scene.description_json`) whose build inputs were
+/// shipped elsewhere: `files` maps each path the description names to the copy to read
+/// instead (a path it lacks is an error, so nothing is read from the sender's folders), and
+/// `instanced` lists the shapes traced through their transforms (`Scene._instanced`).
+#[pyfunction]
+pub fn load_description(
+    py: Python<'_>,
+    json: &str,
+    files: HashMap<PathBuf, PathBuf>,
+    instanced: Vec<usize>,
+) -> PyResult<Scene> {
+    guard(|| {
+        let mut desc: SceneDesc =
+            serde_json::from_str(json).map_err(|e| PyValueError::new_err(format!("not a scene description: {e}")))?;
+        desc.map_build_inputs(&mut |p| {
+            files.get(p).cloned().ok_or_else(|| {
+                glint::Error::new(format!("{}: not among the files shipped with the scene", p.display()))
+            })
+        })
+        .map_err(|e| scene_error(py, e))?;
+        let mut session = Session::from_description(desc);
+        session.set_instanced_shapes(&instanced).map_err(|e| scene_error(py, e))?;
+        Ok(Scene { session })
+    })
+}
+
+/// The material files named by the `mtllib` lines of the OBJ file at `path` whose bytes
+/// are `data`: what reading it reads besides it.
+#[pyfunction]
+pub fn obj_material_files(path: PathBuf, data: &[u8]) -> Vec<PathBuf> {
+    glint::io::obj::mtllib_files(data, &path)
+}
+
 fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAny>> {
     Ok(match v {
         ParamValue::Float(x) => (*x as f64).into_pyobject(py)?.into_any(),
@@ -125,6 +159,17 @@ impl Scene {
     /// The scene description as JSON text (glint's plain-data `SceneDesc`).
     fn description_json(&self) -> String {
         serde_json::to_string(self.session.description()).unwrap_or_default()
+    }
+
+    /// The files the build reads (meshes, textures, environment maps), each once; the
+    /// scene file and its includes are not among them (the description holds them).
+    fn build_inputs(&self) -> Vec<PathBuf> {
+        self.session.description().build_inputs()
+    }
+
+    /// Shapes traced through their transforms since an in-place edit of them.
+    fn _instanced(&self) -> Vec<usize> {
+        self.session.instanced_shapes()
     }
 
     /// Editable parameters as (name, value) pairs; a colour is ("color", [r, g, b]), a

@@ -15,7 +15,7 @@ use crate::lights::LightSelection;
 use crate::math::{Rgb, Vec3};
 use crate::sampling::{PixelFilter, SamplerKind};
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 mod integrator;
 pub mod limits;
@@ -307,17 +307,27 @@ impl SceneDesc {
     }
 
     /// Every file the scene reads (the scene file, its includes, meshes, textures,
-    /// environment maps), each once: what a checkpoint hashes and what a render farm ships.
+    /// environment maps), each once: what a checkpoint hashes.
     pub fn files(&self) -> Vec<PathBuf> {
+        let mut out: Vec<PathBuf> = Vec::new();
+        for p in self.source.iter().chain(&self.includes).cloned().chain(self.build_inputs()) {
+            if !out.contains(&p) {
+                out.push(p);
+            }
+        }
+        out
+    }
+
+    /// The files the build reads (meshes, textures, environment maps), each once; not the
+    /// scene file and its includes, whose content the description already holds. With
+    /// the description, what a render farm ships to its workers.
+    pub fn build_inputs(&self) -> Vec<PathBuf> {
         let mut out: Vec<PathBuf> = Vec::new();
         let mut add = |p: &PathBuf| {
             if !out.contains(p) {
                 out.push(p.clone());
             }
         };
-        for p in self.source.iter().chain(&self.includes) {
-            add(p);
-        }
         for m in &self.materials {
             for t in m.model.textures() {
                 if let TextureDesc::Bitmap { file, .. } = t {
@@ -341,6 +351,36 @@ impl SceneDesc {
         out
     }
 
+    /// Rewrites every path of [`SceneDesc::build_inputs`] (a worker that received the
+    /// files points the description at its own copies); `f` may refuse a path.
+    pub fn map_build_inputs<E>(&mut self, f: &mut dyn FnMut(&Path) -> Result<PathBuf, E>) -> Result<(), E> {
+        let mut map = |p: &mut PathBuf| -> Result<(), E> {
+            *p = f(p)?;
+            Ok(())
+        };
+        for m in &mut self.materials {
+            for t in m.model.textures_mut() {
+                if let TextureDesc::Bitmap { file, .. } = t {
+                    map(file)?;
+                }
+            }
+        }
+        for m in &mut self.meshes {
+            map(&mut m.file)?;
+        }
+        for s in &mut self.shapes {
+            if let Geometry::MeshFile { file, .. } = &mut s.geometry {
+                map(file)?;
+            }
+        }
+        for l in &mut self.lights {
+            if let LightKind::EnvMap { file, .. } = &mut l.light {
+                map(file)?;
+            }
+        }
+        Ok(())
+    }
+
     /// The index of the material called `name`.
     pub fn material_index(&self, name: &str) -> Option<usize> {
         self.materials.iter().position(|m| m.name == name)
@@ -349,6 +389,15 @@ impl SceneDesc {
 
 impl MaterialModel {
     pub fn textures(&self) -> Vec<&TextureDesc> {
+        match self {
+            MaterialModel::Diffuse { reflectance } => vec![reflectance],
+            MaterialModel::Phong { kd, .. } => vec![kd],
+            MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
+            MaterialModel::Conductor { .. } | MaterialModel::Dielectric { .. } | MaterialModel::Black => vec![],
+        }
+    }
+
+    pub fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         match self {
             MaterialModel::Diffuse { reflectance } => vec![reflectance],
             MaterialModel::Phong { kd, .. } => vec![kd],
@@ -392,6 +441,86 @@ mod tests {
             flip_normals: false,
             loc: SourceLoc::new("a.json", 3, 5),
         });
+        let text = serde_json::to_string(&d).unwrap();
+        let back: SceneDesc = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, d);
+    }
+
+    fn desc_with_files() -> SceneDesc {
+        let mut d = SceneDesc::empty(
+            CameraDesc::default(),
+            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default() },
+        );
+        d.source = Some("scene.xml".into());
+        d.includes.push("part.xml".into());
+        let bitmap = |f: &str| TextureDesc::Bitmap {
+            file: f.into(),
+            raw: false,
+            uv_scale: [1.0; 2],
+            uv_offset: [0.0; 2],
+            loc: SourceLoc::default(),
+        };
+        d.materials.push(MaterialDesc {
+            name: "wood".into(),
+            model: MaterialModel::Diffuse { reflectance: bitmap("wood.png") },
+            two_sided: false,
+            loc: SourceLoc::default(),
+        });
+        d.meshes.push(MeshFileDesc {
+            name: "m".into(),
+            file: "bunny.ply".into(),
+            face_normals: false,
+            loc: SourceLoc::default(),
+        });
+        for file in ["box.obj", "bunny.ply"] {
+            d.shapes.push(ShapeDesc {
+                geometry: Geometry::MeshFile { file: file.into(), face_normals: false },
+                to_world: IDENTITY,
+                material: MaterialRef::DefaultDiffuse,
+                use_mtl: false,
+                emission: None,
+                flip_normals: false,
+                loc: SourceLoc::default(),
+            });
+        }
+        d.lights.push(LightDesc {
+            light: LightKind::EnvMap { file: "sky.exr".into(), scale: 1.0, to_world: IDENTITY },
+            loc: SourceLoc::default(),
+        });
+        d
+    }
+
+    #[test]
+    fn build_inputs_are_the_files_less_the_scene_text_and_map_in_place() {
+        let mut d = desc_with_files();
+        let inputs: Vec<PathBuf> = ["wood.png", "bunny.ply", "box.obj", "sky.exr"].iter().map(PathBuf::from).collect();
+        assert_eq!(d.build_inputs(), inputs);
+        let mut files = vec![PathBuf::from("scene.xml"), "part.xml".into()];
+        files.extend(inputs.clone());
+        assert_eq!(d.files(), files);
+        // Every path the build reads is visited (the shared mesh once per place it is named).
+        let mut seen = Vec::new();
+        d.map_build_inputs(&mut |p| {
+            seen.push(p.to_path_buf());
+            Ok::<_, ()>(Path::new("copies").join(p))
+        })
+        .unwrap();
+        assert_eq!(seen.len(), 5);
+        assert_eq!(d.build_inputs(), inputs.iter().map(|p| Path::new("copies").join(p)).collect::<Vec<_>>());
+        assert_eq!(d.source, Some("scene.xml".into()));
+        assert_eq!(d.map_build_inputs(&mut |_| Err("refused")), Err("refused"));
+    }
+
+    #[test]
+    fn numbers_round_trip_through_json_exactly() {
+        // A render farm ships the description as JSON: a number that came back one bit off
+        // would change the image. 0.1 + 0.2 needs 17 digits.
+        let mut d = desc_with_files();
+        let awkward = [0.1 + 0.2, std::f64::consts::PI / 7.0, 1.0 / 3.0, -2.0f64.sqrt() * 1e-7, 123456.789e10];
+        d.shapes[0].to_world[0] = [awkward[0], awkward[1], awkward[2], awkward[3]];
+        d.shapes[0].to_world[1][3] = awkward[4];
+        d.camera.fov_degrees = (1.0f32 / 3.0) * 100.0;
+        d.camera.lens_radius = f32::MIN_POSITIVE * 3.0;
         let text = serde_json::to_string(&d).unwrap();
         let back: SceneDesc = serde_json::from_str(&text).unwrap();
         assert_eq!(back, d);

@@ -5,7 +5,7 @@
 
 use crate::math::{Rgb, Vec3};
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 #[derive(Clone, Debug, Default)]
 pub struct ObjGroup {
@@ -122,10 +122,8 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjFile, String> {
                 });
             }
             "mtllib" => {
-                let dir = path.parent().unwrap_or(Path::new("."));
                 for name in &rest {
-                    let mtl_path = dir.join(name);
-                    materials.extend(read_mtl(&mtl_path).map_err(|e| err(path, line, e))?);
+                    materials.extend(read_mtl(&mtl_path(path, name)).map_err(|e| err(path, line, e))?);
                 }
             }
             "f" => {
@@ -216,6 +214,30 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjFile, String> {
     Ok(ObjFile { groups, materials })
 }
 
+/// Where an `mtllib` name of the OBJ file `obj` points: beside it.
+fn mtl_path(obj: &Path, name: &str) -> PathBuf {
+    obj.parent().unwrap_or(Path::new(".")).join(name)
+}
+
+/// The material files that the `mtllib` lines of an OBJ file held in memory name, each once:
+/// what reading the OBJ at `path` reads besides it (a render farm ships them with it). Text
+/// that is not UTF-8 names none (reading it fails anyway).
+pub fn mtllib_files(data: &[u8], path: &Path) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = Vec::new();
+    let Ok(text) = std::str::from_utf8(data) else { return out };
+    for (_, key, rest) in statements(text) {
+        if key == "mtllib" {
+            for name in rest {
+                let p = mtl_path(path, name);
+                if !out.contains(&p) {
+                    out.push(p);
+                }
+            }
+        }
+    }
+    out
+}
+
 pub fn read_mtl(path: &Path) -> Result<Vec<MtlMaterial>, String> {
     // Bounded: an `mtllib` line may name anything, /dev/zero included.
     let data = super::read_file_bounded(path, super::MAX_MESH_FILE_BYTES)?;
@@ -271,6 +293,16 @@ mod tests {
         assert!(e.starts_with("m.obj:1:"), "{e}");
         let e = parse_obj("v 0 0 zero\n", Path::new("m.obj")).unwrap_err();
         assert!(e.contains("not a number"), "{e}");
+    }
+
+    #[test]
+    fn mtllib_files_are_the_ones_the_reader_opens() {
+        let obj = "mtllib a.mtl  b.mtl # comment\nv 0 0 0\nmtllib a.mtl\n# mtllib c.mtl\n";
+        let files = mtllib_files(obj.as_bytes(), Path::new("models/m.obj"));
+        assert_eq!(files, [PathBuf::from("models/a.mtl"), PathBuf::from("models/b.mtl")]);
+        let e = parse_obj(obj, Path::new("models/m.obj")).unwrap_err();
+        assert!(e.contains("models/a.mtl"), "{e}");
+        assert!(mtllib_files(b"mtllib \xff.mtl", Path::new("m.obj")).is_empty());
     }
 
     #[test]

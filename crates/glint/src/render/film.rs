@@ -304,6 +304,45 @@ impl Film {
         Ok(())
     }
 
+    /// The parts of the region that pass `p` still lacks, as disjoint rectangles: all of
+    /// it for a pass not begun, none for a pass that is in, and for a pass that a merge of
+    /// scattered blocks holds in part (a render farm's checkpoint), the row strips of the
+    /// grid that the blocks' edges make, joined where they line up.
+    pub fn missing(&self, p: u32) -> Vec<Rect> {
+        let have: Vec<Rect> = self.blocks.iter().filter(|b| b.passes.contains(&p)).map(|b| b.region).collect();
+        if have.is_empty() {
+            return vec![self.region];
+        }
+        let cuts = |ends: &dyn Fn(&Rect) -> [u32; 2]| {
+            let mut v: Vec<u32> = have.iter().chain([&self.region]).flat_map(ends).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+        let (xs, ys) = (cuts(&|r| [r.x0, r.x1]), cuts(&|r| [r.y0, r.y1]));
+        let mut out: Vec<Rect> = Vec::new();
+        for y in ys.windows(2) {
+            let mut strip: Vec<Rect> = Vec::new();
+            for x in xs.windows(2) {
+                let cell = Rect { x0: x[0], y0: y[0], x1: x[1], y1: y[1] };
+                if have.iter().any(|r| r.contains(&cell)) {
+                    continue;
+                }
+                match strip.last_mut() {
+                    Some(last) if last.x1 == cell.x0 => last.x1 = cell.x1,
+                    _ => strip.push(cell),
+                }
+            }
+            for r in strip {
+                match out.iter_mut().find(|o| o.x0 == r.x0 && o.x1 == r.x1 && o.y1 == r.y0) {
+                    Some(above) => above.y1 = r.y1,
+                    None => out.push(r),
+                }
+            }
+        }
+        out
+    }
+
     /// Every pass over every pixel of the region is in.
     pub fn is_complete(&self) -> bool {
         self.passes_done() == self.pass_count()
@@ -647,6 +686,26 @@ mod tests {
         assert_eq!(img.get(0, 0), Rgb::splat(2.0));
         assert_eq!(img.get(7, 0), Rgb::BLACK);
         assert!(a.record_block(Block { region: Rect::full(8, 6), passes: 0..1 }).is_err());
+    }
+
+    #[test]
+    fn missing_is_what_a_pass_lacks() {
+        let corner = Rect { x0: 0, y0: 0, x1: 4, y1: 3 };
+        let mut a = filled(corner, 0..2, 1.0);
+        assert_eq!(a.missing(2), [corner]);
+        assert!(a.missing(1).is_empty());
+        a.merge(&filled(Rect { x0: 4, y0: 3, x1: 8, y1: 6 }, 0..1, 1.0)).unwrap();
+        // The merged film covers the whole image; nothing has pass 2 yet.
+        assert_eq!(a.missing(2), [Rect::full(8, 6)]);
+        // Pass 0 lacks the other two quadrants, pass 1 three of them.
+        assert_eq!(a.missing(0), [Rect { x0: 4, y0: 0, x1: 8, y1: 3 }, Rect { x0: 0, y0: 3, x1: 4, y1: 6 }]);
+        assert_eq!(a.missing(1), [Rect { x0: 4, y0: 0, x1: 8, y1: 3 }, Rect { x0: 0, y0: 3, x1: 8, y1: 6 }]);
+        // Filling in what is missing completes the pass, with no overlap.
+        for r in a.missing(0) {
+            a.merge(&filled(r, 0..1, 1.0)).unwrap();
+        }
+        assert!(a.missing(0).is_empty());
+        assert_eq!(a.passes_done(), 1);
     }
 
     #[test]

@@ -213,12 +213,9 @@ impl Session {
                 report.timed_out = true;
                 break;
             }
-            let request = PassRequest { passes: pass..pass + 1, adaptive: control.adaptive };
-            let outcome =
-                render_passes(&world, &integrator, &settings, film, &request, control.cancel, control.progress)
-                    .map_err(Error::new)?;
-            add_stats(&mut report.stats, &outcome.stats);
-            if outcome.cancelled {
+            let job = PassJob { world: &world, integrator: &integrator, settings: &settings, control };
+            let cancelled = job.fill_in(film, pass, &mut report.stats)?;
+            if cancelled {
                 report.cancelled = true;
                 break;
             }
@@ -294,6 +291,24 @@ impl Session {
         Ok(Resumed { session: s, film, job })
     }
 
+    /// Shapes whose transform was edited in place, traced through it rather than baked:
+    /// with the description, what a worker needs to build the same world.
+    pub fn instanced_shapes(&self) -> Vec<usize> {
+        self.instanced.iter().copied().collect()
+    }
+
+    /// Traces these shapes through their transforms (as after an in-place edit of each);
+    /// the world is built again on next use.
+    pub fn set_instanced_shapes(&mut self, shapes: &[usize]) -> Result<(), Error> {
+        let n = self.desc.shapes.len();
+        if let Some(bad) = shapes.iter().find(|&&i| i >= n) {
+            return Err(Error::new(format!("instanced shape {bad}: the scene has {n} shapes")));
+        }
+        self.instanced = shapes.iter().copied().collect();
+        self.world = None;
+        Ok(())
+    }
+
     /// The adaptive settings the film was (or is being) rendered with.
     pub fn adaptive(&self) -> Option<Adaptive> {
         self.adaptive
@@ -335,6 +350,51 @@ pub fn merge_films(paths: &[PathBuf]) -> Result<(Film, RenderJob, u64), Error> {
         film.merge(&other).map_err(|e| Error::at(&loc, e))?;
     }
     Ok((film, job, hash))
+}
+
+/// What rendering one pass of a session needs.
+struct PassJob<'a> {
+    world: &'a World,
+    integrator: &'a Integrator,
+    settings: &'a RenderSettings,
+    control: &'a RenderControl<'a>,
+}
+
+impl PassJob<'_> {
+    /// Renders what pass `pass` lacks: usually the whole region; nothing if the film holds
+    /// the pass; only the missing rectangles for a film merged from scattered blocks (a
+    /// render farm's checkpoint), each rendered into a film of its own and merged. Returns
+    /// whether it was cancelled (a cancelled pass adds nothing, or, when filled in, only
+    /// the rectangles finished).
+    fn fill_in(&self, film: &mut Film, pass: u32, stats: &mut RenderStats) -> Result<bool, Error> {
+        let missing = film.missing(pass);
+        let request = PassRequest { passes: pass..pass + 1, adaptive: self.control.adaptive };
+        let (cancel, progress) = (self.control.cancel, self.control.progress);
+        if missing == [film.region()] {
+            let outcome = render_passes(self.world, self.integrator, self.settings, film, &request, cancel, progress)
+                .map_err(Error::new)?;
+            add_stats(stats, &outcome.stats);
+            return Ok(outcome.cancelled);
+        }
+        if self.control.adaptive.is_some() && !missing.is_empty() {
+            return Err(Error::new(format!(
+                "pass {pass} is in the film for part of the image only; adaptive sampling cannot fill it in"
+            )));
+        }
+        for region in missing {
+            let mut part = Film::new(film.width(), film.height(), region, film.pass_spp(), film.spp(), film.aovs())
+                .map_err(Error::new)?;
+            let outcome =
+                render_passes(self.world, self.integrator, self.settings, &mut part, &request, cancel, progress)
+                    .map_err(Error::new)?;
+            add_stats(stats, &outcome.stats);
+            if outcome.cancelled {
+                return Ok(true);
+            }
+            film.merge(&part).map_err(Error::new)?;
+        }
+        Ok(false)
+    }
 }
 
 fn add_stats(total: &mut RenderStats, s: &RenderStats) {
