@@ -118,7 +118,8 @@ fn disk_light_above_the_point() {
         .then_after(&Transform::rotate(Vec3::X, 90.0))
         .then_after(&Transform::scale(Vec3::splat(r)).unwrap());
     let disk = disk_mesh(BvhSplit::Sah);
-    let ring: Vec<Vec3> = disk.positions[1..].iter().map(|&p| xf.point(p)).collect();
+    // Triangle i of the fan is (centre, rim i, rim i + 1): the rim in order.
+    let ring: Vec<Vec3> = disk.positions.iter().skip(1).step_by(3).map(|&p| xf.point(p)).collect();
     assert!(xf.vector(Vec3::Z).y < 0.0, "the disk must face the plane");
     b.add_mesh_instance(&Arc::new(disk), &xf, false, m, emission(le), false).unwrap();
     let scene = finish(b);

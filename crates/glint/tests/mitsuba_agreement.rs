@@ -159,3 +159,9 @@ fn blackbody_against_a_spectral_render() {
 fn serialized_meshes() {
     check("serialized");
 }
+
+/// The disk's polar uv mapping, as Mitsuba's.
+#[test]
+fn disk_polar_uv() {
+    check("disk");
+}

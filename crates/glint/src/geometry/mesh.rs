@@ -268,17 +268,24 @@ pub fn rectangle_mesh(split: BvhSplit) -> TriangleMesh {
 /// Triangles in the fan of a disk: every format's disk is this one mesh.
 pub const DISK_SEGMENTS: u32 = 256;
 
-/// Unit disk in the z = 0 plane facing +z, as a fan of [`DISK_SEGMENTS`] triangles.
+/// Unit disk in the z = 0 plane facing +z, as a fan of [`DISK_SEGMENTS`] triangles, with
+/// Mitsuba's polar uv: u the radius, v the azimuth over 2 pi (0 along +x, growing towards
+/// +y). Each triangle has its own three vertices, so that v does not wrap across the seam
+/// and the centre's v is the middle of its segment.
 pub fn disk_mesh(split: BvhSplit) -> TriangleMesh {
     let segments = DISK_SEGMENTS;
-    let mut positions = vec![Vec3::ZERO];
-    let mut uvs = vec![[0.5, 0.5]];
-    for i in 0..segments {
+    let rim = |i: u32| {
         let phi = 2.0 * std::f32::consts::PI * i as f32 / segments as f32;
-        positions.push(Vec3 { x: phi.cos(), y: phi.sin(), z: 0.0 });
-        uvs.push([0.5 + 0.5 * phi.cos(), 0.5 + 0.5 * phi.sin()]);
+        Vec3 { x: phi.cos(), y: phi.sin(), z: 0.0 }
+    };
+    let mut positions = Vec::with_capacity(3 * segments as usize);
+    let mut uvs = Vec::with_capacity(3 * segments as usize);
+    for i in 0..segments {
+        let v = |k: f32| k / segments as f32;
+        positions.extend([Vec3::ZERO, rim(i), rim((i + 1) % segments)]);
+        uvs.extend([[0.0, v(i as f32 + 0.5)], [1.0, v(i as f32)], [1.0, v(i as f32 + 1.0)]]);
     }
-    let indices = (0..segments).map(|i| [0, 1 + i, 1 + (i + 1) % segments]).collect();
+    let indices = (0..segments).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
     TriangleMesh::new(positions, None, Some(uvs), indices, split).expect("valid disk")
 }
 

@@ -122,6 +122,8 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
     for c in &root.children {
         let result = match c.tag.as_str() {
             "shape" => r.shape(c),
+            // A named area emitter is described when a shape refers to it.
+            "emitter" if c.attr("type") == Some("area") && c.attr("id").is_some() => Ok(()),
             "emitter" => r.emitter(c),
             "sensor" => {
                 sensor = Some(c);
@@ -416,6 +418,8 @@ impl<'a> Reader<'a> {
                 "ref" => self.resolve(c).and_then(|target| match target.tag.as_str() {
                     "bsdf" => self.material(target).map(|m| material = Some(m)),
                     "medium" => Err(c.err("<medium> (participating media) is not supported")),
+                    // A named area emitter at scene level, as Mitsuba allows.
+                    "emitter" => self.area_emitter(target).map(|e| emission = Some(e)),
                     other => Err(c.err(format!("a shape cannot refer to a <{other}>"))),
                 }),
                 "emitter" => self.area_emitter(c).map(|e| emission = Some(e)),
