@@ -474,7 +474,7 @@ mod tests {
         });
         for file in ["box.obj", "bunny.ply"] {
             d.shapes.push(ShapeDesc {
-                geometry: Geometry::MeshFile { file: file.into(), face_normals: false },
+                geometry: Geometry::MeshFile { file: file.into(), face_normals: false, shape_index: 0 },
                 to_world: IDENTITY,
                 material: MaterialRef::DefaultDiffuse,
                 use_mtl: false,
