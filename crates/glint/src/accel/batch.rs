@@ -2,8 +2,8 @@
 //! BVH, several traversals interleaved on one thread.
 //!
 //! One ray's traversal is a chain of dependent steps (load a node, test it, choose the next,
-//! load that), so a single ray mostly waits for memory (BENCHMARKS.md, "What the profile
-//! shows"). Here `LANES` traversals, each with its own stack, advance round-robin one node
+//! load that), and the profile suggested a single ray mostly waits (BENCHMARKS.md, "What the
+//! profile shows"). Here `LANES` traversals, each with its own stack, advance round-robin one node
 //! visit per turn; after its turn a lane prefetches the node it visits next, and the other
 //! lanes' turns run while that load is in flight. When a lane's ray is done the lane takes the
 //! next ray of the batch.
@@ -12,7 +12,8 @@
 //! step, with the same float operations in the same order, so every ray's answer is
 //! bit-identical to its single-ray query (the tests check this ray by ray). The single-ray
 //! loops are kept as they are: their state lives in registers, which these turns cannot
-//! keep across lanes.
+//! keep across lanes. Measured (BENCHMARKS.md, "Many rays in flight"): 5 to 8% faster on
+//! diffuse rays at best, 15 to 20% slower on primary rays; the renderer does not use it.
 
 use super::simd::Isa;
 use super::wide::{leaf_mask, leaf_range, AnyLeaf, ClosestLeaf, NodeRay, WideBvh, WideNode, EMPTY_CHILD, FAR_SCALE};
@@ -22,8 +23,8 @@ use std::marker::PhantomData;
 use std::mem::MaybeUninit;
 
 /// Traversals in flight per thread. 1, 4, 8 and 16 were measured (BENCHMARKS.md, "Many rays
-/// in flight"): none was measurably faster than single-ray traversal on the machine of those
-/// figures; 8 is what the literature suggests for hiding an L2/L3 miss.
+/// in flight"): on diffuse rays 8 and 16 were about equal and ahead of 1 and 4; fewer lanes
+/// keep the lanes' stacks' live entries in L1.
 pub const LANES: usize = 8;
 
 /// One ray's traversal in flight: the node it visits next and its stack.
