@@ -169,7 +169,7 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
         println!("{out}");
     } else {
         for (k, v) in out.as_object().into_iter().flatten() {
-            println!("{k:<22} {v}");
+            println!("{k:<26} {v}");
         }
     }
     Ok(())
