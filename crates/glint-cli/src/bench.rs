@@ -1,11 +1,13 @@
 //! `glint bench`: ray throughput of glint's BVH on a ray file, for comparison with other
 //! engines (bench/compare-embree). Every ray is traced for the closest hit and, separately,
 //! for occlusion, several times; the best run counts, as timings on a shared machine only
-//! ever err on the slow side.
+//! ever err on the slow side. `--batch` also traces them through the batch API (several rays
+//! in flight per thread), in runs interleaved with the single-ray ones so that the two are
+//! measured under the same load, and checks that both give the same answers ray by ray.
 
 use crate::{meshsrc, rays};
 use clap::Args;
-use glint::accel::{BvhSplit, SimdPath};
+use glint::accel::{BvhSplit, SimdPath, TriangleHit, BATCH_LANES};
 use glint::geometry::{MeshAccel, TriangleMesh};
 use glint::math::Ray;
 use rayon::prelude::*;
@@ -41,6 +43,9 @@ pub struct BenchArgs {
     /// Split strategy of the binary build that the wide BVH is collapsed from.
     #[arg(long, default_value = "sah", value_parser = |s: &str| s.parse::<BvhSplit>())]
     split: BvhSplit,
+    /// Also trace through the batch API and report its Mrays/s beside the single-ray figures.
+    #[arg(long)]
+    batch: bool,
 }
 
 pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
@@ -73,36 +78,62 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
         build_s = build_s.min(start.elapsed().as_secs_f64());
     }
     let stats = mesh.accel_stats();
-    let trace_closest = |r: &Ray| -> f32 {
-        let mut r = *r;
-        mesh.intersect_with(&mut r, simd).map_or(f32::INFINITY, |(_, h)| h.t)
-    };
+    let trace_closest = |r: &Ray| mesh.intersect_with(&mut r.clone(), simd);
     const CHUNK: usize = 1024;
-    let mut hits = vec![0f32; rays.len()];
-    let mut closest_s = f64::INFINITY;
-    let mut occluded_s = f64::INFINITY;
-    let mut occluded = 0usize;
-    for _ in 0..a.repeat {
+    let mut hits: Vec<Option<(u32, TriangleHit)>> = vec![None; rays.len()];
+    let mut batch_hits = hits.clone();
+    let mut batch_blocked = vec![false; rays.len()];
+    let (mut closest_s, mut occluded_s) = (f64::INFINITY, f64::INFINITY);
+    let (mut batch_closest_s, mut batch_occluded_s) = (f64::INFINITY, f64::INFINITY);
+    let mut blocked = vec![false; rays.len()];
+    // Best of `repeat` for each kind; with `--batch` the four kinds take turns in each round.
+    let timed = |f: &mut (dyn FnMut() + Send)| {
         let start = Instant::now();
-        pool.install(|| {
+        pool.install(&mut *f);
+        start.elapsed().as_secs_f64()
+    };
+    for _ in 0..a.repeat {
+        closest_s = closest_s.min(timed(&mut || {
             hits.par_chunks_mut(CHUNK).zip(rays.par_chunks(CHUNK)).for_each(|(h, r)| {
                 for (h, r) in h.iter_mut().zip(r) {
                     *h = trace_closest(r);
                 }
             })
-        });
-        closest_s = closest_s.min(start.elapsed().as_secs_f64());
-        let start = Instant::now();
-        occluded = pool
-            .install(|| rays.par_chunks(CHUNK).map(|c| c.iter().filter(|r| mesh.occluded_with(r, simd)).count()).sum());
-        occluded_s = occluded_s.min(start.elapsed().as_secs_f64());
+        }));
+        if a.batch {
+            batch_closest_s = batch_closest_s.min(timed(&mut || {
+                batch_hits
+                    .par_chunks_mut(CHUNK)
+                    .zip(rays.par_chunks(CHUNK))
+                    .for_each(|(h, r)| mesh.intersect_batch_with(r, h, simd))
+            }));
+        }
+        occluded_s = occluded_s.min(timed(&mut || {
+            blocked.par_chunks_mut(CHUNK).zip(rays.par_chunks(CHUNK)).for_each(|(b, r)| {
+                for (b, r) in b.iter_mut().zip(r) {
+                    *b = mesh.occluded_with(r, simd);
+                }
+            })
+        }));
+        if a.batch {
+            batch_occluded_s = batch_occluded_s.min(timed(&mut || {
+                batch_blocked
+                    .par_chunks_mut(CHUNK)
+                    .zip(rays.par_chunks(CHUNK))
+                    .for_each(|(b, r)| mesh.occluded_batch_with(r, b, simd))
+            }));
+        }
     }
-    let hit_count = hits.iter().filter(|t| t.is_finite()).count();
+    let hit_count = hits.iter().filter(|h| h.is_some()).count();
+    let occluded = blocked.iter().filter(|&&b| b).count();
     if hit_count != occluded {
         return Err(format!("internal error: {hit_count} closest hits but {occluded} occluded rays"));
     }
+    if a.batch {
+        check_batch(&hits, &blocked, &batch_hits, &batch_blocked)?;
+    }
     if let Some(p) = &a.hits {
-        let bytes: Vec<u8> = hits.iter().flat_map(|t| t.to_le_bytes()).collect();
+        let bytes: Vec<u8> = hits.iter().flat_map(|h| h.map_or(f32::INFINITY, |h| h.1.t).to_le_bytes()).collect();
         std::fs::write(p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
     }
     let n = rays.len() as f64;
@@ -124,11 +155,42 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
         "nodes": stats.nodes,
         "leaves": stats.leaves,
     });
+    let mut out = out;
+    if a.batch {
+        let o = out.as_object_mut().unwrap();
+        o.insert("batch_lanes".into(), BATCH_LANES.into());
+        o.insert("batch_closest_mrays_per_s".into(), (n / batch_closest_s / 1e6).into());
+        o.insert("batch_occluded_mrays_per_s".into(), (n / batch_occluded_s / 1e6).into());
+        // Same-run ratios: the figures that mean something on a shared machine.
+        o.insert("batch_closest_speedup".into(), (closest_s / batch_closest_s).into());
+        o.insert("batch_occluded_speedup".into(), (occluded_s / batch_occluded_s).into());
+    }
     if a.json {
         println!("{out}");
     } else {
         for (k, v) in out.as_object().into_iter().flatten() {
-            println!("{k:<22} {v}");
+            println!("{k:<26} {v}");
+        }
+    }
+    Ok(())
+}
+
+/// The batch API must give each ray the single-ray answer: the same triangle and the same
+/// distance and barycentrics, bit for bit, and the same occlusion.
+fn check_batch(
+    single: &[Option<(u32, TriangleHit)>],
+    single_blocked: &[bool],
+    batch: &[Option<(u32, TriangleHit)>],
+    batch_blocked: &[bool],
+) -> Result<(), String> {
+    let key = |h: &Option<(u32, TriangleHit)>| h.map(|(p, h)| (p, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
+    for (i, (s, b)) in single.iter().zip(batch).enumerate() {
+        if key(s) != key(b) {
+            return Err(format!("internal error: ray {i}: single-ray hit {s:?}, batch hit {b:?}"));
+        }
+        if single_blocked[i] != batch_blocked[i] {
+            let (s, b) = (single_blocked[i], batch_blocked[i]);
+            return Err(format!("internal error: ray {i}: single-ray occlusion {s}, batch occlusion {b}"));
         }
     }
     Ok(())

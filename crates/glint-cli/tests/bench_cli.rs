@@ -1,6 +1,8 @@
 //! `glint rays` and `glint bench`: the JSON is well-formed with the documented fields, and
 //! the `--hits` file agrees ray by ray with the reference binary BVH (bit for bit) and with
-//! testing every triangle. No timing is asserted: benchmarks are not tests.
+//! testing every triangle. With `--batch` the batch figures are there too (and `bench`
+//! itself fails if the batch answers differ from the single-ray ones on any ray). No timing
+//! is asserted: benchmarks are not tests.
 
 use glint::accel::BvhSplit;
 use glint::geometry::TriangleMesh;
@@ -46,7 +48,9 @@ fn bench_json_is_well_formed_and_hits_match_the_reference() {
         let rays_path = dir.join(format!("{kind}.rays"));
         let hits_path = dir.join(format!("{kind}.hits"));
         glint(&["rays", "--mesh", mesh_arg, "--kind", kind, "--count", "3000", "-o", rays_path.to_str().unwrap()]);
-        let out = glint(&[
+        // Diffuse rays through the batch API as well; primary rays without it.
+        let batch = kind == "diffuse";
+        let mut args = vec![
             "bench",
             "--mesh",
             mesh_arg,
@@ -54,11 +58,35 @@ fn bench_json_is_well_formed_and_hits_match_the_reference() {
             rays_path.to_str().unwrap(),
             "--json",
             "--repeat",
-            "1",
+            "2",
             "--hits",
             hits_path.to_str().unwrap(),
-        ]);
+        ];
+        if batch {
+            args.push("--batch");
+        }
+        let out = glint(&args);
         let j: serde_json::Value = serde_json::from_str(out.trim()).expect("one JSON object");
+        let batch_keys =
+            ["batch_closest_mrays_per_s", "batch_occluded_mrays_per_s", "batch_closest_speedup", "batch_occluded_speedup"];
+        for key in batch_keys {
+            if batch {
+                let v = j[key].as_f64().unwrap_or_else(|| panic!("{key} missing or not a number in {out}"));
+                assert!(v.is_finite() && v > 0.0, "{key} = {v}");
+            } else {
+                assert!(j.get(key).is_none(), "{key} without --batch: {out}");
+            }
+        }
+        if batch {
+            assert_eq!(j["batch_lanes"].as_u64(), Some(glint::accel::BATCH_LANES as u64));
+            // The speedups are the ratios of the figures they sit beside.
+            for kind in ["closest", "occluded"] {
+                let ratio = j[format!("batch_{kind}_mrays_per_s")].as_f64().unwrap()
+                    / j[format!("{kind}_mrays_per_s")].as_f64().unwrap();
+                let speedup = j[format!("batch_{kind}_speedup")].as_f64().unwrap();
+                assert!((ratio / speedup - 1.0).abs() < 1e-9, "{kind}: {ratio} against {speedup}");
+            }
+        }
         for key in [
             "triangles",
             "rays",

@@ -1,6 +1,7 @@
 //! Acceleration structures: the binary SAH BVH (the reference), the wide SIMD BVH collapsed
 //! from it, and triangle intersection.
 
+mod batch;
 mod binning;
 mod build;
 mod bvh;
@@ -12,6 +13,7 @@ mod triangle;
 pub mod wide;
 mod wide_mesh;
 
+pub use batch::LANES as BATCH_LANES;
 pub use bvh::{
     BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, TraversalVisits, MAX_DEPTH, SAH_DEPTH_LIMIT, SAH_INTERSECT_COST,
     SAH_TRAVERSAL_COST,

@@ -26,7 +26,7 @@ const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 pub const MAX_LEAF_ITEMS: usize = 16;
 /// An unused child slot. It has the leaf bit set, but its range is not valid: soundness
 /// rests on no ray ever hitting its empty box, which [`NodeRay::new`] guarantees.
-const EMPTY_CHILD: u32 = u32::MAX;
+pub(super) const EMPTY_CHILD: u32 = u32::MAX;
 
 #[inline(always)]
 pub fn leaf_ref(first: usize, count: usize) -> u32 {
@@ -183,7 +183,7 @@ impl<F: FnMut(u32, u32, &Ray) -> bool> AnyLeaf for FnLeaf<F> {
 /// once, so at a node of depth d the stack holds at most (d - 1)(W - 1) entries before it
 /// pushes, W after: d(W - 1) + 1. A wide tree is no deeper than the binary tree it was
 /// collapsed from, which the build keeps within `MAX_DEPTH`; `collapse` checks this.
-const STACK: usize = MAX_DEPTH * 7 + 1;
+pub(super) const STACK: usize = MAX_DEPTH * 7 + 1;
 
 impl<const W: usize> WideBvh<W> {
     /// Collapses `bvh`. `leaf(first, count)` turns a binary leaf (a range of
@@ -461,7 +461,7 @@ impl<const W: usize> WideBvh<W> {
 /// sign bits of the child references, gathered by `movmskps` (SSE2, always present on
 /// x86-64) four at a time.
 #[inline(always)]
-fn leaf_mask<const W: usize>(node: &WideNode<W>) -> u32 {
+pub(super) fn leaf_mask<const W: usize>(node: &WideNode<W>) -> u32 {
     #[cfg(target_arch = "x86_64")]
     if W.is_multiple_of(4) {
         use std::arch::x86_64::{_mm_castsi128_ps, _mm_loadu_si128, _mm_movemask_ps};

@@ -173,6 +173,85 @@ impl<const W: usize> TriangleWideBvh<W> {
         self.tree.occluded::<S>(ray, &mut leaf)
     }
 
+    /// Closest hits of many rays: `hits[i]` is what [`TriangleWideBvh::intersect`] returns
+    /// for `rays[i]`, bit for bit, but several rays are traced at once per thread (see
+    /// `batch.rs`), which hides memory latency.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>], path: SimdPath) {
+        assert_eq!(rays.len(), hits.len(), "intersect_batch: one hit slot per ray");
+        // SAFETY (every arm): each path runs only where the CPU has it.
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 if path.is_available() => unsafe { self.intersect_batch_avx2(rays, hits) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 if path.is_available() => unsafe { self.intersect_batch_avx512(rays, hits) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.intersect_batch_generic::<Sse>(rays, hits) },
+            _ => unsafe { self.intersect_batch_generic::<Scalar>(rays, hits) },
+        }
+    }
+
+    /// Occlusion of many rays: `blocked[i]` is [`TriangleWideBvh::occluded`] of `rays[i]`.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn occluded_batch(&self, rays: &[Ray], blocked: &mut [bool], path: SimdPath) {
+        assert_eq!(rays.len(), blocked.len(), "occluded_batch: one answer per ray");
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 if path.is_available() => unsafe { self.occluded_batch_avx2(rays, blocked) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 if path.is_available() => unsafe { self.occluded_batch_avx512(rays, blocked) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.occluded_batch_generic::<Sse>(rays, blocked) },
+            _ => unsafe { self.occluded_batch_generic::<Scalar>(rays, blocked) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn intersect_batch_avx2(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>]) {
+        self.intersect_batch_generic::<Avx2>(rays, hits)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    unsafe fn intersect_batch_avx512(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>]) {
+        self.intersect_batch_generic::<Avx2>(rays, hits)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn occluded_batch_avx2(&self, rays: &[Ray], blocked: &mut [bool]) {
+        self.occluded_batch_generic::<Avx2>(rays, blocked)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    unsafe fn occluded_batch_avx512(&self, rays: &[Ray], blocked: &mut [bool]) {
+        self.occluded_batch_generic::<Avx2>(rays, blocked)
+    }
+
+    #[inline(always)]
+    unsafe fn intersect_batch_generic<S: Isa>(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>]) {
+        let blocks: &[Tri4] = &self.blocks;
+        self.tree.traverse_batch::<S, Closest<S>>(
+            rays,
+            |r| Closest { blocks, tr: TriRay::new(r), best: None, isa: PhantomData },
+            |i, _, leaf| hits[i] = leaf.best,
+        );
+    }
+
+    #[inline(always)]
+    unsafe fn occluded_batch_generic<S: Isa>(&self, rays: &[Ray], blocked: &mut [bool]) {
+        let blocks: &[Tri4] = &self.blocks;
+        self.tree.occluded_batch::<S, Any<S>>(
+            rays,
+            |r| Any { blocks, tr: TriRay::new(r), isa: PhantomData },
+            |i, b| blocked[i] = b,
+        );
+    }
+
     /// Whether the tree is a single leaf (tiny meshes).
     pub fn is_single_leaf(&self) -> bool {
         self.tree.root() & LEAF_BIT != 0

@@ -181,6 +181,37 @@ impl TriangleMesh {
         }
     }
 
+    /// Closest hits of many rays at once: `hits[i]` is what `intersect_with(rays[i], path)`
+    /// returns, bit for bit (the wide trees trace several rays in flight per thread; the
+    /// binary reference goes ray by ray). Panics if the slices differ in length.
+    pub fn intersect_batch_with(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>], path: SimdPath) {
+        match &self.wide {
+            WideTris::W8(w) => w.intersect_batch(rays, hits, path),
+            WideTris::W4(w) => w.intersect_batch(rays, hits, path),
+            WideTris::None => {
+                assert_eq!(rays.len(), hits.len(), "intersect_batch: one hit slot per ray");
+                for (r, h) in rays.iter().zip(hits) {
+                    *h = self.intersect_reference(&mut r.clone());
+                }
+            }
+        }
+    }
+
+    /// Occlusion of many rays at once: `blocked[i]` is `occluded_with(rays[i], path)`.
+    /// Panics if the slices differ in length.
+    pub fn occluded_batch_with(&self, rays: &[Ray], blocked: &mut [bool], path: SimdPath) {
+        match &self.wide {
+            WideTris::W8(w) => w.occluded_batch(rays, blocked, path),
+            WideTris::W4(w) => w.occluded_batch(rays, blocked, path),
+            WideTris::None => {
+                assert_eq!(rays.len(), blocked.len(), "occluded_batch: one answer per ray");
+                for (r, b) in rays.iter().zip(blocked) {
+                    *b = self.occluded_reference(r);
+                }
+            }
+        }
+    }
+
     /// Closest hit through the binary BVH: the reference implementation.
     #[inline]
     pub fn intersect_reference(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
