@@ -8,7 +8,7 @@
 //! have given it, which multiple importance sampling relies on.
 //!
 //! Cases: spheres seen from outside (cone sampling), near and far; rectangles near enough
-//! to be sampled by solid angle, and one so far that it falls back to area sampling.
+//! to be sampled by solid angle, and one so far that it is sampled by area.
 
 mod common;
 
@@ -59,8 +59,9 @@ fn sphere_case(label: &'static str, center: Vec3, radius: f32, p: Vec3) -> Case 
     }
 }
 
-/// A rectangle `corner + s ex + t ey` (ex ⟂ ey) emitting towards `p`.
-fn rectangle_case(label: &'static str, corner: Vec3, ex: Vec3, ey: Vec3, p: Vec3) -> Case {
+/// A rectangle `corner + s ex + t ey` (ex ⟂ ey) emitting towards `p`, sampled from there by
+/// solid angle or by area as `by_solid_angle` says.
+fn rectangle_case(label: &'static str, corner: Vec3, ex: Vec3, ey: Vec3, p: Vec3, by_solid_angle: bool) -> Case {
     let (c1, c2, c3) = (corner + ex, corner + ex + ey, corner + ey);
     let mut n = ex.cross(ey).normalize();
     let mut tris = [[corner, c1, c2], [corner, c2, c3]];
@@ -70,6 +71,7 @@ fn rectangle_case(label: &'static str, corner: Vec3, ex: Vec3, ey: Vec3, p: Vec3
     }
     let emitter = MeshEmitter::new(tris.to_vec()).unwrap();
     assert!(emitter.rectangle.is_some(), "{label}: not detected as a rectangle");
+    assert_eq!(emitter.samples_by_solid_angle(p), by_solid_angle, "{label}: the other sampler");
     let center = corner + (ex + ey) * 0.5;
     let axis = (center - p).normalize();
     let frame = Frame::from_normal(axis);
@@ -111,6 +113,7 @@ fn cases() -> Vec<Case> {
             vec3(2.0, 0.0, 0.0),
             vec3(0.0, 0.0, 1.4),
             Vec3::ZERO,
+            true,
         ),
         rectangle_case(
             "oblique rectangle off to the side",
@@ -118,6 +121,7 @@ fn cases() -> Vec<Case> {
             vec3(0.6, 0.8, 0.0),
             vec3(0.0, 0.0, 0.7),
             vec3(-0.3, 0.1, 0.0),
+            true,
         ),
         rectangle_case(
             "far rectangle (area sampling)",
@@ -125,6 +129,7 @@ fn cases() -> Vec<Case> {
             vec3(0.0, 0.1, 0.0),
             vec3(0.0, 0.0, 0.1),
             Vec3::ZERO,
+            false,
         ),
     ]
 }

@@ -58,6 +58,11 @@ impl MeshEmitter {
         Some(MeshEmitter { triangles, areas, total_area, rectangle })
     }
 
+    /// Whether light samples seen from `p` are drawn by solid angle (otherwise by area).
+    pub fn samples_by_solid_angle(&self, p: Vec3) -> bool {
+        self.spherical_rectangle(p).is_some()
+    }
+
     /// The solid-angle parametrization to sample from `p`, where it applies.
     fn spherical_rectangle(&self, p: Vec3) -> Option<SphericalRectangle> {
         self.rectangle.as_ref().and_then(|r| SphericalRectangle::new(r, p))

@@ -5,9 +5,10 @@
 //! suffers the 1/d² spikes of area sampling.
 //!
 //! Done in f64: the solid angle is a sum of four angles less 2π, which cancels badly in f32.
-//! Where the solid angle is tiny (far away or edge-on) or close to a hemisphere (right on the
-//! light), the caller samples by area instead; the choice depends on the point alone, so the
-//! density given to a BSDF-sampled direction always matches the sampler's.
+//! Where area sampling is nearly uniform in solid angle anyway (the light far away compared
+//! with its size), where the solid angle is tiny (edge-on) or close to a hemisphere (right on
+//! the light), the caller samples by area instead; the choice depends on the point alone, so
+//! the density given to a BSDF-sampled direction always matches the sampler's.
 
 use crate::math::{vec3, Vec3};
 
@@ -15,6 +16,10 @@ use crate::math::{vec3, Vec3};
 const MIN_SOLID_ANGLE: f64 = 1e-4;
 /// Above this (near the full hemisphere of 2π sr) the point almost touches the light.
 const MAX_SOLID_ANGLE: f64 = 6.2;
+/// Area sampling's density in solid angle, d³/h (h: the point's height over the light's
+/// plane), varies across the light by at most (d_max/d_min)³. Below this bound area sampling
+/// is nearly uniform in solid angle already and far cheaper (no trigonometry), so it is kept.
+const MIN_AREA_PDF_SPREAD: f64 = 2.0;
 
 /// A rectangular emitter: `corner + s ex + t ey` for s, t in [0, 1], with `ex ⟂ ey`, and
 /// `normal` the side its triangles face.
@@ -112,6 +117,12 @@ impl SphericalRectangle {
         }
         let (x0, y0) = (dot(d, x), dot(d, y));
         let (x1, y1) = (x0 + lx, y0 + ly);
+        let near2 = x0.max(0.0).min(x1).powi(2) + y0.max(0.0).min(y1).powi(2) + z0 * z0;
+        let far2 = x0.abs().max(x1.abs()).powi(2) + y0.abs().max(y1.abs()).powi(2) + z0 * z0;
+        let r = far2 / near2;
+        if r * r * r < MIN_AREA_PDF_SPREAD * MIN_AREA_PDF_SPREAD {
+            return None;
+        }
         let (v00, v01, v10, v11) = ([x0, y0, z0], [x0, y1, z0], [x1, y0, z0], [x1, y1, z0]);
         let n0 = unit(cross(v00, v10));
         let n1 = unit(cross(v10, v11));
