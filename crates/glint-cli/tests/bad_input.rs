@@ -234,6 +234,9 @@ fn mitsuba_scene_reports_every_unsupported_feature() {
     let lines: Vec<&str> = err.lines().collect();
     assert_eq!(lines.len(), 3, "{err}");
     for (line, (n, what)) in lines.iter().zip([(3, "cylinder"), (4, "velvet"), (5, "projector")]) {
-        assert!(line.starts_with("glint: error: ") && line.contains(&format!("many.xml:{n}:")) && line.contains(what), "{err}");
+        assert!(
+            line.starts_with("glint: error: ") && line.contains(&format!("many.xml:{n}:")) && line.contains(what),
+            "{err}"
+        );
     }
 }

@@ -67,8 +67,12 @@ fn bench_json_is_well_formed_and_hits_match_the_reference() {
         }
         let out = glint(&args);
         let j: serde_json::Value = serde_json::from_str(out.trim()).expect("one JSON object");
-        let batch_keys =
-            ["batch_closest_mrays_per_s", "batch_occluded_mrays_per_s", "batch_closest_speedup", "batch_occluded_speedup"];
+        let batch_keys = [
+            "batch_closest_mrays_per_s",
+            "batch_occluded_mrays_per_s",
+            "batch_closest_speedup",
+            "batch_occluded_speedup",
+        ];
         for key in batch_keys {
             if batch {
                 let v = j[key].as_f64().unwrap_or_else(|| panic!("{key} missing or not a number in {out}"));

@@ -69,7 +69,9 @@ fn ray_for(mesh: &TriangleMesh, (kind, a, b, c, d): (u8, f32, f32, f32, f32)) ->
         2 => Ray::new(origin, p0.lerp(p1, b.abs().fract()) - origin),
         // Grazing: in the plane of a flat part of the height field.
         3 => Ray::new(vec3(origin.x, p0.y, origin.z), vec3(a, 0.0, c - 0.3)),
-        4 => Ray::new(origin, [vec3(1.0, 0.0, 0.0), vec3(0.0, -1.0, 0.0), vec3(0.0, 0.0, 1.0)][(kind as usize / 12) % 3]),
+        4 => {
+            Ray::new(origin, [vec3(1.0, 0.0, 0.0), vec3(0.0, -1.0, 0.0), vec3(0.0, 0.0, 1.0)][(kind as usize / 12) % 3])
+        }
         5 => {
             let (u, v) = (b.abs().fract() * 0.5, c.abs().fract() * 0.5);
             Ray::new(p0 * (1.0 - u - v) + p1 * u + p2 * v, vec3(d, a - 0.5, c))
@@ -79,7 +81,11 @@ fn ray_for(mesh: &TriangleMesh, (kind, a, b, c, d): (u8, f32, f32, f32, f32)) ->
         8 => Ray::new(vec3(f32::INFINITY, c, d), vec3(-1.0, 0.0, 0.0)),
         9 => Ray::new(origin, vec3(f32::INFINITY, 1.0, 0.0)),
         10 => Ray { t_min: f32::NAN, ..Ray::new(origin, p0 - origin) },
-        _ => Ray { t_min: 0.0, t_max: [f32::NAN, 0.0, 2.5, -1.0][(kind as usize / 12) % 4], ..Ray::new(origin, p0 - origin) },
+        _ => Ray {
+            t_min: 0.0,
+            t_max: [f32::NAN, 0.0, 2.5, -1.0][(kind as usize / 12) % 4],
+            ..Ray::new(origin, p0 - origin)
+        },
     };
     // Some rays get a short interval, so that culling by `t_max` is exercised.
     if kind >= 128 && ray.t_max == f32::INFINITY {
@@ -106,7 +112,13 @@ fn check_batch(mesh: &TriangleMesh, rays: &[Ray]) -> Result<(), TestCaseError> {
             let single = mesh.intersect_with(&mut ray.clone(), path);
             prop_assert_eq!(bits(&hits[i]), bits(&single), "{} ray {} of {}: {:?}", path, i, rays.len(), ray);
             let reference = mesh.intersect_reference(&mut ray.clone());
-            prop_assert_eq!(hits[i].map(|h| h.1.t.to_bits()), reference.map(|h| h.1.t.to_bits()), "{} ray {:?}", path, ray);
+            prop_assert_eq!(
+                hits[i].map(|h| h.1.t.to_bits()),
+                reference.map(|h| h.1.t.to_bits()),
+                "{} ray {:?}",
+                path,
+                ray
+            );
             prop_assert_eq!(blocked[i], mesh.occluded_with(ray, path), "{} ray {} occlusion: {:?}", path, i, ray);
             prop_assert_eq!(blocked[i], mesh.occluded_reference(ray), "{} ray {:?}", path, ray);
             if !(ray.origin.is_finite() && ray.dir.is_finite()) {

@@ -118,12 +118,15 @@ fn scene_level_sampler_and_film() {
         p
     };
     let sampler = |id: &str, n: u32| {
-        format!(r#"<sampler type="independent" {id}><integer name="sample_count" value="{n}"/><integer name="seed" value="3"/></sampler>"#)
+        format!(
+            r#"<sampler type="independent" {id}><integer name="sample_count" value="{n}"/><integer name="seed" value="3"/></sampler>"#
+        )
     };
     let d = read(&scene("ref.xml", &sampler("id=\"s\"", 7), &format!("<ref id=\"s\"/>{FILM}"))).unwrap();
     assert_eq!((d.sampler.spp, d.sampler.seed), (7, 3));
     assert!(d.warnings.is_empty(), "{:?}", d.warnings);
-    let d = read(&scene("named.xml", &sampler("id=\"s\"", 5), &format!("<ref name=\"sampler\" id=\"s\"/>{FILM}"))).unwrap();
+    let d =
+        read(&scene("named.xml", &sampler("id=\"s\"", 5), &format!("<ref name=\"sampler\" id=\"s\"/>{FILM}"))).unwrap();
     assert_eq!(d.sampler.spp, 5);
     // A scene-level film, referred to.
     let film = FILM.replace("<film ", "<film id=\"f\" ");
@@ -132,9 +135,14 @@ fn scene_level_sampler_and_film() {
     // Unreferenced: ignored with a warning naming file and line.
     let d = read(&scene("unused.xml", &sampler("", 7), FILM)).unwrap();
     assert_eq!(d.sampler.spp, 16);
-    assert!(d.warnings.len() == 1 && d.warnings[0].contains("unused.xml:2:") && d.warnings[0].contains("ignored"), "{:?}", d.warnings);
+    assert!(
+        d.warnings.len() == 1 && d.warnings[0].contains("unused.xml:2:") && d.warnings[0].contains("ignored"),
+        "{:?}",
+        d.warnings
+    );
     // Two samplers for one sensor: an error, as in Mitsuba.
-    let e = read(&scene("two.xml", &sampler("id=\"s\"", 7), &format!("<ref id=\"s\"/>\n{}{FILM}", sampler("", 9)))).unwrap_err();
+    let e = read(&scene("two.xml", &sampler("id=\"s\"", 7), &format!("<ref id=\"s\"/>\n{}{FILM}", sampler("", 9))))
+        .unwrap_err();
     assert!(e.contains("two.xml:5:") && e.contains("only one <sampler>"), "{e}");
 }
 
@@ -457,7 +465,10 @@ fn every_unsupported_feature_is_reported() {
     ];
     assert_eq!(lines.len(), expect.len(), "{e}");
     for ((line, what), got) in expect.iter().zip(&lines) {
-        assert!(got.contains(&format!("many.xml:{line}:")) && got.contains(what), "expected line {line} ({what}): {got}\n{e}");
+        assert!(
+            got.contains(&format!("many.xml:{line}:")) && got.contains(what),
+            "expected line {line} ({what}): {got}\n{e}"
+        );
     }
 }
 

@@ -79,12 +79,12 @@ pub fn parse_serialized(data: &[u8], shape_index: u32) -> Result<SerializedMesh,
         }
         let back = count - shape_index; // entries from this one to the end of the dictionary
         let offset = if version == 4 {
-            (back as usize)
-                .checked_mul(8)
-                .and_then(|b| data.len().checked_sub(4 + b))
-                .and_then(|at| u64_at(data, at))
+            (back as usize).checked_mul(8).and_then(|b| data.len().checked_sub(4 + b)).and_then(|at| u64_at(data, at))
         } else {
-            (back as usize).checked_mul(4).and_then(|b| data.len().checked_sub(4 + b)).and_then(|at| u32_at(data, at).map(u64::from))
+            (back as usize)
+                .checked_mul(4)
+                .and_then(|b| data.len().checked_sub(4 + b))
+                .and_then(|at| u32_at(data, at).map(u64::from))
         };
         let offset = offset.ok_or_else(|| format!("the mesh dictionary ({count} meshes) does not fit in the file"))?;
         if offset > data.len() as u64 {
@@ -203,7 +203,5 @@ pub fn angle_weighted_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<V
             }
         }
     }
-    acc.into_iter()
-        .map(|n| if n.length_squared() > 0.0 { n.normalize() } else { Vec3::X })
-        .collect()
+    acc.into_iter().map(|n| if n.length_squared() > 0.0 { n.normalize() } else { Vec3::X }).collect()
 }

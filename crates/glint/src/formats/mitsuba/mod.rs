@@ -95,7 +95,11 @@ pub fn read_str_with_includes(
     describe_tree(path, &xml::load_tree_str(text, path, &defines, source)?, source)
 }
 
-fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::IncludeSource<'a>) -> Result<SceneDesc, Error> {
+fn describe_tree<'a>(
+    path: &Path,
+    tree: &'a xml::SceneTree,
+    source: xml::IncludeSource<'a>,
+) -> Result<SceneDesc, Error> {
     let root = &tree.root;
     let mut r = Reader {
         tree,
@@ -136,9 +140,7 @@ fn describe_tree<'a>(path: &Path, tree: &'a xml::SceneTree, source: xml::Include
             // Named BSDFs and textures are described when a shape refers to them, samplers
             // and films when the sensor does (an unreferenced one is ignored, as by Mitsuba).
             "bsdf" | "texture" | "sampler" | "film" => Ok(()),
-            "medium" | "phase" | "volume" => {
-                Err(c.err(format!("<{}> (participating media) is not supported", c.tag)))
-            }
+            "medium" | "phase" | "volume" => Err(c.err(format!("<{}> (participating media) is not supported", c.tag))),
             other => Err(c.err(format!("unexpected element <{other}> in <scene>"))),
         };
         r.note(result);
@@ -439,13 +441,19 @@ impl<'a> Reader<'a> {
                 let file = p.string("filename").ok_or_else(|| el.err("shape 'serialized' needs 'filename'"))?;
                 let path = self.resolve_file(el, file);
                 if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("serialized")) {
-                    return Err(el.err(format!("serialized: glint reads these meshes from .serialized files, not '{file}'")));
+                    return Err(
+                        el.err(format!("serialized: glint reads these meshes from .serialized files, not '{file}'"))
+                    );
                 }
                 let index = p.int("shape_index", 0)?;
                 if !(0..=u32::MAX as i64).contains(&index) {
                     return Err(el.err(format!("serialized: shape_index {index} must be 0 or more")));
                 }
-                Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)?, shape_index: index as u32 }
+                Geometry::MeshFile {
+                    file: path,
+                    face_normals: p.bool("face_normals", false)?,
+                    shape_index: index as u32,
+                }
             }
             "sphere" => {
                 Geometry::Sphere { center: p.point("center")?.unwrap_or(Vec3::ZERO), radius: p.float("radius", 1.0)? }
@@ -479,7 +487,8 @@ impl<'a> Reader<'a> {
             )));
         }
         let ep = Props::new(c);
-        let emission = Emission { radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?, two_sided: false };
+        let emission =
+            Emission { radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?, two_sided: false };
         self.warn_unused(&ep);
         Ok(emission)
     }

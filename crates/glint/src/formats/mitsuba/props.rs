@@ -196,7 +196,9 @@ fn spectrum_of(e: &Element, usage: SpectrumUse) -> Result<Rgb, Error> {
         return Ok(rgb);
     }
     if e.attr("filename").is_some() {
-        return Err(e.err("spectra read from files (<spectrum filename>) are not supported; give value=\"wavelength:value, ...\""));
+        return Err(e.err(
+            "spectra read from files (<spectrum filename>) are not supported; give value=\"wavelength:value, ...\"",
+        ));
     }
     let v = e.required("value")?;
     let tokens: Vec<&str> = v.split(|c: char| c == ',' || c.is_whitespace()).filter(|t| !t.is_empty()).collect();

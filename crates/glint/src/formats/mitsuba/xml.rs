@@ -122,7 +122,11 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Element, Error> {
             .map_err(|e| Error::at(&loc_at(reader.error_position() as usize), format!("malformed XML: {e}")))?;
         // The event starts at the first '<' after the previous event. (Searched as bytes:
         // the reader's position need not be a char boundary, e.g. inside a second BOM.)
-        let start = text.as_bytes().get(before..).and_then(|b| b.iter().position(|&c| c == b'<')).map_or(before, |o| before + o);
+        let start = text
+            .as_bytes()
+            .get(before..)
+            .and_then(|b| b.iter().position(|&c| c == b'<'))
+            .map_or(before, |o| before + o);
         let make = |e: &quick_xml::events::BytesStart| -> Result<Element, Error> {
             let tag = String::from_utf8_lossy(e.name().as_ref()).to_string();
             let mut attrs = Vec::new();
@@ -236,7 +240,11 @@ pub fn load_tree_str(
     load_tree_from(parse_str(text, path)?, defines, source)
 }
 
-fn load_tree_from(mut root: Element, defines: &[(String, String)], source: IncludeSource<'_>) -> Result<SceneTree, Error> {
+fn load_tree_from(
+    mut root: Element,
+    defines: &[(String, String)],
+    source: IncludeSource<'_>,
+) -> Result<SceneTree, Error> {
     let mut included = Includes::default();
     if root.tag != "scene" {
         return Err(root.err(format!("the root element is <{}>, expected <scene>", root.tag)));
@@ -456,16 +464,23 @@ mod tests {
         let files = memory(&[
             // ../../common does not exist next to include/, but does through the search path
             // (the scene's folder): Mitsuba's documentation scenes rely on this.
-            ("docs/scenes/include/part.xml", r#"<scene version="3.0.0"><path value="../../common"/><include filename="inner.xml"/></scene>"#),
+            (
+                "docs/scenes/include/part.xml",
+                r#"<scene version="3.0.0"><path value="../../common"/><include filename="inner.xml"/></scene>"#,
+            ),
             ("common/inner.xml", &format!(r#"<scene version="3.0.0">{}</scene>"#, shape("mesh.obj"))),
             ("common/mesh.obj", OBJ),
             ("docs/common/.keep", ""),
             // A <path> relative to the included file, used by the file it includes.
-            ("docs/scenes/sub/a.xml", r#"<scene version="3.0.0"><path value="assets"/><include filename="d.xml"/></scene>"#),
+            (
+                "docs/scenes/sub/a.xml",
+                r#"<scene version="3.0.0"><path value="assets"/><include filename="d.xml"/></scene>"#,
+            ),
             ("docs/scenes/sub/assets/d.xml", &format!(r#"<scene version="3.0.0">{}</scene>"#, shape("here.obj"))),
             ("docs/scenes/sub/assets/here.obj", OBJ),
         ]);
-        let text = r#"<scene version="3.0.0"><include filename="include/part.xml"/><include filename="sub/a.xml"/></scene>"#;
+        let text =
+            r#"<scene version="3.0.0"><include filename="include/part.xml"/><include filename="sub/a.xml"/></scene>"#;
         let main = Path::new("/m/docs/scenes/main.xml");
         let err = load_tree_str(text, main, &[], IncludeSource::Memory(&files)).unwrap_err();
         // /m/docs/common exists, so ../../common relative to include/ is that folder, in which
