@@ -99,6 +99,12 @@ pub(super) struct SphericalRectangle {
 impl SphericalRectangle {
     /// `None` where the rectangle should be sampled by area from `p` (see the module doc).
     pub fn new(r: &Rectangle, p: Vec3) -> Option<SphericalRectangle> {
+        Self::with_min_spread(r, p, MIN_AREA_PDF_SPREAD)
+    }
+
+    /// [`SphericalRectangle::new`] with the area-density spread below which area sampling is
+    /// kept as a parameter (tests of the parametrization pass 0: always by solid angle).
+    fn with_min_spread(r: &Rectangle, p: Vec3, min_spread: f64) -> Option<SphericalRectangle> {
         let (ex, ey) = (wide(r.ex), wide(r.ey));
         let (lx, ly) = (dot(ex, ex).sqrt(), dot(ey, ey).sqrt());
         let x = unit(ex);
@@ -120,7 +126,7 @@ impl SphericalRectangle {
         let near2 = x0.max(0.0).min(x1).powi(2) + y0.max(0.0).min(y1).powi(2) + z0 * z0;
         let far2 = x0.abs().max(x1.abs()).powi(2) + y0.abs().max(y1.abs()).powi(2) + z0 * z0;
         let r = far2 / near2;
-        if r * r * r < MIN_AREA_PDF_SPREAD * MIN_AREA_PDF_SPREAD {
+        if r * r * r < min_spread * min_spread {
             return None;
         }
         let (v00, v01, v10, v11) = ([x0, y0, z0], [x0, y1, z0], [x1, y0, z0], [x1, y1, z0]);
@@ -201,7 +207,7 @@ mod tests {
     #[test]
     fn solid_angle_matches_the_triangle_formula() {
         for p in [vec3(0.0, 0.0, 0.0), vec3(2.0, -1.0, 3.0), vec3(0.1, 1.05, 0.0), vec3(-3.0, 4.0, 1.0)] {
-            let s = SphericalRectangle::new(&rect(), p).unwrap();
+            let s = SphericalRectangle::with_min_spread(&rect(), p, 0.0).unwrap();
             let other = solid_angle_of_triangles(&rect(), p);
             // The corners are summed in f32 for the triangles: agreement to f32 rounding.
             assert!((s.solid_angle() / other - 1.0).abs() < 1e-6, "{p:?}: {} vs {other}", s.solid_angle());
@@ -212,7 +218,7 @@ mod tests {
     fn samples_lie_on_the_rectangle() {
         let r = rect();
         let n = r.ex.cross(r.ey).normalize();
-        let s = SphericalRectangle::new(&r, vec3(0.3, -0.2, 0.4)).unwrap();
+        let s = SphericalRectangle::with_min_spread(&r, vec3(0.3, -0.2, 0.4), 0.0).unwrap();
         for i in 0..32 {
             for j in 0..32 {
                 let u = [(i as f32 + 0.5) / 32.0, (j as f32 + 0.5) / 32.0];
