@@ -78,6 +78,28 @@ fn defines_override_defaults_and_refs_resolve() {
     assert!(e.contains("badref.xml:8:") && e.contains("nope"), "{e}");
 }
 
+/// `-D name=value` for a name the scene gives no `<default>` still substitutes `$name`, and is
+/// a warning naming the file and the name (most often a typo); one with a default is silent.
+#[test]
+fn a_define_without_a_default_is_a_warning() {
+    use glint::formats::Define;
+    let text = format!(
+        "<scene version=\"3.0.0\">\n<default name=\"r\" value=\"0.5\"/>\n{SENSOR}\n<shape type=\"sphere\">\n <float name=\"radius\" value=\"$r\"/>\n</shape>\n</scene>\n"
+    );
+    let define = |name: &str, value: &str| Define { name: name.into(), value: value.into() };
+    let path = std::path::Path::new("defines.xml");
+    let with_default = glint::formats::mitsuba::read_str(&text, path, &[define("r", "2")]).unwrap();
+    assert!(!with_default.warnings.iter().any(|w| w.contains("-D")), "{:?}", with_default.warnings);
+    let typo = glint::formats::mitsuba::read_str(&text, path, &[define("radius", "2")]).unwrap();
+    let warned: Vec<_> = typo.warnings.iter().filter(|w| w.contains("-D radius")).collect();
+    assert_eq!(warned.len(), 1, "{:?}", typo.warnings);
+    assert!(warned[0].starts_with("defines.xml") && !warned[0].contains('\n'), "{}", warned[0]);
+    // Without a default the define still substitutes (as Mitsuba does).
+    let text = text.replace("<default name=\"r\" value=\"0.5\"/>\n", "");
+    let s = glint::formats::mitsuba::read_str(&text, path, &[define("r", "2")]).unwrap();
+    assert!(s.warnings.iter().any(|w| w.contains("-D r:")), "{:?}", s.warnings);
+}
+
 /// The `direct` integrator's counts as Mitsuba reads them: `shading_samples` sets both, each
 /// of `emitter_samples` and `bsdf_samples` overrides one; giving both kinds, a negative count,
 /// or no sample at all is an error.

@@ -109,7 +109,7 @@ fn describe_tree<'a>(
         materials: Vec::new(),
         shapes: Vec::new(),
         lights: Vec::new(),
-        warnings: Vec::new(),
+        warnings: tree.warnings.clone(),
         errors: Vec::new(),
     };
     for c in &root.children {

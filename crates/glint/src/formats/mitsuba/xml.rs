@@ -199,6 +199,8 @@ pub struct SceneTree {
     /// Mitsuba's search path for the files that plugins name (meshes, textures, ...): the
     /// scene file's `<path>` folders, the last one first, then the scene file's own folder.
     pub search: Vec<PathBuf>,
+    /// What was read but had no effect (a `-D` name with no `<default>`), one line each.
+    pub warnings: Vec<String>,
 }
 
 impl SceneTree {
@@ -274,11 +276,17 @@ fn load_tree_from(
             true
         }
     });
+    let mut warnings = Vec::new();
     for (k, v) in defines {
+        // As Mitsuba: a define still substitutes `$name`, but one the scene gives no default
+        // is most often a typo, so it is said.
+        if !values.contains_key(k) {
+            warnings.push(format!("{}: -D {k}: the scene has no <default name=\"{k}\">", root.file.display()));
+        }
         values.insert(k.clone(), v.clone());
     }
     substitute(&mut root, &values)?;
-    Ok(SceneTree { root, included: included.files, search })
+    Ok(SceneTree { root, included: included.files, search, warnings })
 }
 
 /// The files included so far, and how many `<include>`s were expanded in all.
