@@ -1,6 +1,7 @@
 //! Materials: what a surface is made of, with textured parameters. `Material::bsdf`
 //! evaluates the textures at a hit point and returns the [`Bsdf`] to scatter with.
 
+mod conductor_presets;
 mod texture;
 pub use texture::{Bitmap, Texture};
 
@@ -124,17 +125,13 @@ impl Material {
     }
 }
 
-/// Complex refractive indices (eta, k) in RGB for Mitsuba's named conductor presets: the
-/// values Mitsuba 3.9.1's `scalar_rgb` variant uses (read back from it with `mi.traverse`).
+/// Complex refractive indices (eta, k) in RGB for Mitsuba's named conductor presets (the
+/// values of Mitsuba 3.9.1's `scalar_rgb` variant, [`conductor_presets`]); "none" is a perfect
+/// mirror.
 pub fn conductor_preset(name: &str) -> Option<(Rgb, Rgb)> {
-    use crate::math::rgb;
-    Some(match name {
-        "Au" => (rgb(0.143036, 0.375307, 1.44205), rgb(3.983, 2.38556, 1.60336)),
-        "Ag" => (rgb(0.155276, 0.116728, 0.138388), rgb(4.82835, 3.12222, 2.1469)),
-        "Cu" => (rgb(0.201005, 0.92375, 1.10222), rgb(3.91326, 2.45305, 2.14209)),
-        "Al" => (rgb(1.6575, 0.880405, 0.521244), rgb(9.22381, 6.2695, 4.837)),
-        "Cr" => (rgb(4.36967, 2.91651, 1.6549), rgb(5.20655, 4.23131, 3.7547)),
-        "none" => (Rgb::BLACK, Rgb::WHITE),
-        _ => return None,
-    })
+    if name == "none" {
+        return Some((Rgb::BLACK, Rgb::WHITE));
+    }
+    let p = conductor_presets::CONDUCTOR_PRESETS.iter().find(|p| p.name == name)?;
+    Some((Rgb::from_array(p.eta), Rgb::from_array(p.k)))
 }

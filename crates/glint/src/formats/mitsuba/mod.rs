@@ -339,7 +339,7 @@ impl<'a> Reader<'a> {
         }
         let name = p.string("material").unwrap_or("none");
         conductor_preset(name)
-            .ok_or_else(|| p.el.err(format!("conductor material '{name}' is not known (Au, Ag, Cu, Al, Cr, none)")))
+            .ok_or_else(|| p.el.err(format!("conductor material '{name}' is not one of Mitsuba's conductor presets (Au, Ag, Cu, Al, Cr, ...: see docs/mitsuba-support.md)")))
     }
 
     /// Describes (once) the material of a `<bsdf>` element; its index in the materials.
