@@ -153,3 +153,10 @@ fn serialized_meshes() {
 fn disk_polar_uv() {
     check("disk");
 }
+
+/// Named conductor presets beyond the common metals (`a-C`, `TiN`, `W`, `Cu2O_palik`), smooth
+/// and rough: the RGB values are Mitsuba's own, so the spheres must match.
+#[test]
+fn conductor_presets() {
+    check("conductor-presets");
+}
