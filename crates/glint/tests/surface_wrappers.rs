@@ -61,8 +61,7 @@ fn scene(integrator: &str, sheet_z: Option<f32>, eye_z: f32, light_z: f32) -> St
     )
 }
 
-const DIRECT_LIGHT_SAMPLES: &str =
-    r#"<integrator type="direct"><integer name="emitter_samples" value="1"/><integer name="bsdf_samples" value="0"/></integrator>"#;
+const DIRECT_LIGHT_SAMPLES: &str = r#"<integrator type="direct"><integer name="emitter_samples" value="1"/><integer name="bsdf_samples" value="0"/></integrator>"#;
 
 #[test]
 fn a_half_opaque_sheet_halves_light_on_shadow_rays() {

@@ -137,7 +137,9 @@ mod tests {
             assert!((s.pdf(wo, wi) - plain.pdf(wo, wi)).abs() < 1e-5);
             let u = [rng.next_f32(), rng.next_f32()];
             match (s.sample(wo, 0.5, u), plain.sample(wo, 0.5, u)) {
-                (Some(a), Some(b)) => assert!((a.wi - b.wi).length() < 1e-5 && (a.weight - b.weight).max_component().abs() < 1e-5),
+                (Some(a), Some(b)) => {
+                    assert!((a.wi - b.wi).length() < 1e-5 && (a.weight - b.weight).max_component().abs() < 1e-5)
+                }
                 (None, None) => {}
                 other => panic!("{other:?}"),
             }

@@ -83,7 +83,9 @@ impl TextureCache {
             TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {
                 Texture::Checkerboard { color0: *color0, color1: *color1, uv_scale: *uv_scale, uv_offset: *uv_offset }
             }
-            TextureDesc::MeshAttribute { name, scale, .. } => Texture::MeshAttribute { name: name.clone(), scale: *scale },
+            TextureDesc::MeshAttribute { name, scale, .. } => {
+                Texture::MeshAttribute { name: name.clone(), scale: *scale }
+            }
         })
     }
 }

@@ -212,10 +212,7 @@ enum JsonMaterial {
         distribution: Option<String>,
     },
     /// `material` shaded with a tangent-space normal map.
-    NormalMap {
-        normals: JsonTexture,
-        material: Box<JsonMaterial>,
-    },
+    NormalMap { normals: JsonTexture, material: Box<JsonMaterial> },
     /// `material` shaded with the normals of `scale` times a height texture.
     BumpMap {
         height: JsonTexture,
@@ -224,10 +221,7 @@ enum JsonMaterial {
         material: Box<JsonMaterial>,
     },
     /// `material` where opaque; light passes through with probability 1 - opacity.
-    Mask {
-        opacity: JsonTexture,
-        material: Box<JsonMaterial>,
-    },
+    Mask { opacity: JsonTexture, material: Box<JsonMaterial> },
 }
 
 #[derive(Deserialize)]
@@ -384,11 +378,9 @@ fn texture_of(ctx: &Ctx, json_path: &str, t: &JsonTexture) -> TextureDesc {
             uv_scale: uv_scale.unwrap_or([1.0, 1.0]),
             uv_offset: [0.0, 0.0],
         },
-        JsonTexture::Attribute { attribute, scale } => TextureDesc::MeshAttribute {
-            name: attribute.clone(),
-            scale: scale.unwrap_or(1.0),
-            loc: ctx.loc(json_path),
-        },
+        JsonTexture::Attribute { attribute, scale } => {
+            TextureDesc::MeshAttribute { name: attribute.clone(), scale: scale.unwrap_or(1.0), loc: ctx.loc(json_path) }
+        }
     }
 }
 
@@ -421,14 +413,19 @@ fn material_model_of(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Resul
         if matches!(model, MaterialModel::NormalMap { .. } | MaterialModel::BumpMap { .. })
             && !matches!(m, JsonMaterial::Mask { .. })
         {
-            return Err(ctx.err(&at, format!("material '{name}': a normal or bump map inside another one is not supported")));
+            return Err(
+                ctx.err(&at, format!("material '{name}': a normal or bump map inside another one is not supported"))
+            );
         }
         Ok((Box::new(model), two_sided))
     };
     Ok(match m {
         JsonMaterial::NormalMap { normals, material } => {
             let (nested, two_sided) = nested(material)?;
-            (MaterialModel::NormalMap { normals: texture_of(ctx, &format!("{at}/normals"), normals), nested }, two_sided)
+            (
+                MaterialModel::NormalMap { normals: texture_of(ctx, &format!("{at}/normals"), normals), nested },
+                two_sided,
+            )
         }
         JsonMaterial::BumpMap { height, scale, material } => {
             let (nested, two_sided) = nested(material)?;

@@ -1,9 +1,9 @@
 //! Triangle meshes with their own bottom-level BVH.
 
+use super::MeshAttribute;
 use crate::accel::{
     intersect_triangle, BuildOptions, Bvh, BvhSplit, ShearedRay, SimdPath, TriangleHit, TriangleWideBvh, WideStats,
 };
-use super::MeshAttribute;
 use crate::math::{Aabb, Ray, Vec3};
 
 /// Which acceleration structure a mesh traces with.
@@ -82,7 +82,15 @@ impl TriangleMesh {
         if let Some(p) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("vertex {p} is not finite"));
         }
-        let mut mesh = TriangleMesh { positions, normals, uvs, indices, bvh: Bvh::default(), wide: WideTris::None, attributes: Vec::new() };
+        let mut mesh = TriangleMesh {
+            positions,
+            normals,
+            uvs,
+            indices,
+            bvh: Bvh::default(),
+            wide: WideTris::None,
+            attributes: Vec::new(),
+        };
         mesh.build_bvh(split);
         Ok(mesh)
     }

@@ -4,8 +4,8 @@ mod attributes;
 mod mesh;
 mod sphere;
 
+pub use attributes::{AttributeScope, MeshAttribute};
 pub use mesh::{
     cube_mesh, disk_mesh, quad_mesh, rectangle_mesh, AccelStats, MeshAccel, TriangleMesh, WideTris, DISK_SEGMENTS,
 };
-pub use attributes::{AttributeScope, MeshAttribute};
 pub use sphere::Sphere;

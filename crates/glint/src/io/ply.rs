@@ -427,7 +427,12 @@ mod tests {
         assert_eq!(get("face_color").values, vec![128.0, 64.0, 255.0]);
         assert_eq!(get("face_color").scope, AttributeScope::Face);
         // A quad's face attribute covers both its triangles.
-        let quad = ASCII.replace("property list uchar int vertex_indices", "property list uchar int vertex_indices\nproperty float w_x").replace("4 0 1 2 3", "4 0 1 2 3 0.5");
+        let quad = ASCII
+            .replace(
+                "property list uchar int vertex_indices",
+                "property list uchar int vertex_indices\nproperty float w_x",
+            )
+            .replace("4 0 1 2 3", "4 0 1 2 3 0.5");
         let m = parse_ply(quad.as_bytes(), Path::new("q.ply")).unwrap();
         assert_eq!(m.attributes[0].name, "face_w");
         assert_eq!(m.attributes[0].values, vec![0.5, 0.5]);

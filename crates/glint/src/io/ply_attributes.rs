@@ -25,7 +25,10 @@ pub fn attribute_layout(names: &[&str], reserved: &[&str], prefix: &str) -> Vec<
     let mut colour: Vec<&str> = vec![];
     for set in [["r", "g", "b"], ["red", "green", "blue"]] {
         if set.iter().all(|n| pos(n).is_some()) && colour.is_empty() {
-            out.push(AttributeLayout { name: format!("{prefix}color"), props: set.iter().filter_map(|n| pos(n)).collect() });
+            out.push(AttributeLayout {
+                name: format!("{prefix}color"),
+                props: set.iter().filter_map(|n| pos(n)).collect(),
+            });
             colour = set.to_vec();
         }
     }
@@ -34,16 +37,19 @@ pub fn attribute_layout(names: &[&str], reserved: &[&str], prefix: &str) -> Vec<
     let mut seen: Vec<String> = Vec::new();
     // The group being read: its prefix, scheme and properties.
     let mut group: Option<(String, usize, Vec<usize>)> = None;
-    let flush = |g: &mut Option<(String, usize, Vec<usize>)>, out: &mut Vec<AttributeLayout>, seen: &mut Vec<String>| {
-        if let Some((p, scheme, props)) = g.take() {
-            let name = |suffix: &str| format!("{prefix}{p}{suffix}");
-            if (props.len() == 1 || props.len() == 3) && !out.iter().any(|a| a.name == name(if scheme == 1 { "_color" } else { "" })) {
-                let suffix = if scheme == 1 { "_color" } else { "" };
-                out.push(AttributeLayout { name: format!("{prefix}{p}{suffix}"), props });
+    let flush =
+        |g: &mut Option<(String, usize, Vec<usize>)>, out: &mut Vec<AttributeLayout>, seen: &mut Vec<String>| {
+            if let Some((p, scheme, props)) = g.take() {
+                let name = |suffix: &str| format!("{prefix}{p}{suffix}");
+                if (props.len() == 1 || props.len() == 3)
+                    && !out.iter().any(|a| a.name == name(if scheme == 1 { "_color" } else { "" }))
+                {
+                    let suffix = if scheme == 1 { "_color" } else { "" };
+                    out.push(AttributeLayout { name: format!("{prefix}{p}{suffix}"), props });
+                }
+                seen.push(p);
             }
-            seen.push(p);
-        }
-    };
+        };
     for (i, name) in names.iter().enumerate() {
         if skip(name) {
             continue;
@@ -126,7 +132,10 @@ mod tests {
     fn groups_as_mitsuba_does() {
         let n = ["x", "y", "z", "color_0", "color_1", "color_2", "weight_x"];
         let l = attribute_layout(&n, &["x", "y", "z"], "vertex_");
-        assert_eq!(names(&l), vec![("vertex_color".to_string(), vec![3, 4, 5]), ("vertex_weight".to_string(), vec![6])]);
+        assert_eq!(
+            names(&l),
+            vec![("vertex_color".to_string(), vec![3, 4, 5]), ("vertex_weight".to_string(), vec![6])]
+        );
         let l = attribute_layout(&["x", "blue", "green", "red"], &["x"], "vertex_");
         assert_eq!(names(&l), vec![("vertex_color".to_string(), vec![3, 2, 1])]);
         let l = attribute_layout(&["albedo_r", "albedo_g", "albedo_b", "two_x", "two_y"], &[], "face_");

@@ -124,7 +124,8 @@ impl Texture {
     pub fn luminance_gradient(&self, uv: [f32; 2]) -> [f32; 2] {
         match self {
             Texture::Bitmap { image, uv_scale, uv_offset } => {
-                let g = image.luminance_gradient([uv[0] * uv_scale[0] + uv_offset[0], uv[1] * uv_scale[1] + uv_offset[1]]);
+                let g =
+                    image.luminance_gradient([uv[0] * uv_scale[0] + uv_offset[0], uv[1] * uv_scale[1] + uv_offset[1]]);
                 [g[0] * uv_scale[0], g[1] * uv_scale[1]]
             }
             _ => [0.0, 0.0],

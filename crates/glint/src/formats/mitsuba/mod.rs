@@ -440,7 +440,13 @@ impl<'a> Reader<'a> {
             };
             self.note(result);
         }
-        let material = material.map_or(MaterialRef::DefaultDiffuse, MaterialRef::Index);
+        // Mitsuba gives a shape without a BSDF a diffuse 0.5 one, and an emitting shape a
+        // black one (its light does not reflect light).
+        let material = match (material, &emission) {
+            (Some(m), _) => MaterialRef::Index(m),
+            (None, Some(_)) => MaterialRef::Black,
+            (None, None) => MaterialRef::DefaultDiffuse,
+        };
         let geometry = match ty {
             "obj" | "ply" => {
                 let file = p.string("filename").ok_or_else(|| el.err(format!("shape '{ty}' needs 'filename'")))?;

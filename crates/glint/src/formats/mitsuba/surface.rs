@@ -61,14 +61,20 @@ impl<'a> Reader<'a> {
                 let textures: Vec<&Element> = el
                     .children
                     .iter()
-                    .filter(|c| c.tag == "texture" || (c.tag == "ref" && self.resolve(c).is_ok_and(|t| t.tag == "texture")))
+                    .filter(|c| {
+                        c.tag == "texture" || (c.tag == "ref" && self.resolve(c).is_ok_and(|t| t.tag == "texture"))
+                    })
                     .collect();
                 let [t] = textures[..] else {
-                    return Err(el.err(format!("bumpmap: give exactly one height <texture> (found {})", textures.len())));
+                    return Err(
+                        el.err(format!("bumpmap: give exactly one height <texture> (found {})", textures.len()))
+                    );
                 };
                 let height = self.texture_element(t)?;
                 if !matches!(height, TextureDesc::Bitmap { .. }) {
-                    return Err(t.err("bumpmap: the height texture must be a bitmap (Mitsuba differentiates only those)"));
+                    return Err(
+                        t.err("bumpmap: the height texture must be a bitmap (Mitsuba differentiates only those)")
+                    );
                 }
                 if let Some(name) = t.attr("name") {
                     p.find(name);
