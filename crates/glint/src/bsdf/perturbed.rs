@@ -80,6 +80,16 @@ impl ShadedBsdf {
         if !(wi.z * bs.wi.z > 0.0) {
             return None;
         }
+        if !bs.delta {
+            // Evaluated again at the direction returned: the round trip through the tilted
+            // frame moves it by a rounding error, which near the tilted horizon changes the
+            // cosine noticeably; this keeps weight = eval / pdf exact.
+            let pdf = self.pdf(wo, wi);
+            if !(pdf > 0.0) {
+                return None;
+            }
+            return Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, ..bs });
+        }
         bs.weight = bs.weight * bump_shadowing(f.n, wi);
         bs.wi = wi;
         Some(bs)
