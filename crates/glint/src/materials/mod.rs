@@ -126,7 +126,6 @@ impl Material {
     /// masks: those are applied by the integrators, see [`Perturbation`]).
     #[inline]
     pub fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
-        let uv = p.uv;
         match self.kind.base() {
             MaterialKind::Diffuse { reflectance } => Bsdf::Diffuse { reflectance: reflectance.eval_at(p) },
             MaterialKind::Phong { kd, ks, exponent } => {
@@ -151,10 +150,7 @@ impl Material {
             MaterialKind::Black
             | MaterialKind::NormalMap { .. }
             | MaterialKind::BumpMap { .. }
-            | MaterialKind::Mask { .. } => {
-                let _ = uv;
-                Bsdf::Black
-            }
+            | MaterialKind::Mask { .. } => Bsdf::Black,
         }
     }
 }
