@@ -6,7 +6,8 @@ mod common;
 
 use common::bsdf_check::{chi2_of, dir, draw_samples, integrate, BsdfCase, Integrals, Samples};
 use common::stats::{sidak, z_critical, FALSE_ALARM};
-use glint::bsdf::{Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams};
+use glint::bsdf::{normal_map_frame, Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams, ShadedBsdf};
+use glint::math::vec3;
 use glint::math::{rgb, Rgb};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -21,7 +22,20 @@ const CHI2_SIGNIFICANCE: f64 = 0.01;
 const QUADRATURE_TOLERANCE: f64 = 1e-5;
 
 fn case(name: &str, bsdf: Bsdf, wo_deg: f32, complete: bool) -> BsdfCase {
-    BsdfCase { name: format!("{name}, wo at {wo_deg}°"), bsdf, wo: dir(wo_deg), complete }
+    BsdfCase { name: format!("{name}, wo at {wo_deg}°"), bsdf: bsdf.into(), wo: dir(wo_deg), complete }
+}
+
+/// `bsdf` in the frame a normal map with tangent-space normal `n` tilts it to (samples below
+/// the real surface are refused, so sampling is never complete).
+fn tilted(name: &str, bsdf: Bsdf, n: glint::math::Vec3, wo_deg: f32) -> BsdfCase {
+    let tilt = normal_map_frame(n, dir(wo_deg));
+    assert!(tilt.is_some());
+    BsdfCase {
+        name: format!("{name}, wo at {wo_deg}°"),
+        bsdf: ShadedBsdf { bsdf, tilt },
+        wo: dir(wo_deg),
+        complete: false,
+    }
 }
 
 fn ggx(a: f32) -> Microfacet {
@@ -71,6 +85,15 @@ fn cases() -> Vec<BsdfCase> {
         for wo in [0.0, 70.0] {
             let p = PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, Some(dist));
             v.push(case(&format!("rough plastic {name}"), Bsdf::Plastic(p), wo, false));
+        }
+    }
+    // Normal- and bump-mapped: the BSDF in a tilted frame, with the shadowing term.
+    for (tilt, n) in [("30°", vec3(0.5, 0.0, 0.866)), ("50° skew", vec3(-0.5, 0.55, 0.67))] {
+        for wo in [10.0, 60.0] {
+            let d = Bsdf::Diffuse { reflectance: rgb(0.8, 0.5, 0.2) };
+            v.push(tilted(&format!("diffuse tilted {tilt}"), d, n, wo));
+            let m = Bsdf::RoughConductor { dist: ggx(0.3), eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+            v.push(tilted(&format!("rough conductor GGX 0.3 tilted {tilt}"), m, n, wo));
         }
     }
     v
@@ -208,7 +231,8 @@ fn mean_sample_weight_matches_integrated_eval() {
 
 #[test]
 fn quadrature_is_exact_on_the_diffuse_lobe() {
-    for c in checked().iter().filter(|c| matches!(c.case.bsdf, Bsdf::Diffuse { .. })) {
+    for c in checked().iter().filter(|c| c.case.bsdf.tilt.is_none() && matches!(c.case.bsdf.bsdf, Bsdf::Diffuse { .. }))
+    {
         let albedo = (0.8 + 0.5 + 0.2) / 3.0;
         assert!((c.integrals.pdf_total() - 1.0).abs() < QUADRATURE_TOLERANCE, "{}", c.integrals.pdf_total());
         assert!((c.integrals.eval_total - albedo).abs() < QUADRATURE_TOLERANCE, "{}", c.integrals.eval_total);

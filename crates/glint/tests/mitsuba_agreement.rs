@@ -160,3 +160,27 @@ fn disk_polar_uv() {
 fn conductor_presets() {
     check("conductor-presets");
 }
+
+/// Tangent-space normal maps on a rectangle, a sphere and a cube (Mitsuba's dp/du frames).
+#[test]
+fn normal_maps() {
+    check("normalmap");
+}
+
+/// Bump maps: the exact gradient of a bilinearly filtered height bitmap.
+#[test]
+fn bump_maps() {
+    check("bumpmap");
+}
+
+/// Opacity masks seen by the camera and in shadows (a texture and a constant).
+#[test]
+fn opacity_masks() {
+    check("mask");
+}
+
+/// Per-vertex and per-face PLY attributes as textures.
+#[test]
+fn mesh_attributes() {
+    check("mesh-attribute");
+}

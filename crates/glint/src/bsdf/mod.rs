@@ -16,10 +16,12 @@
 
 mod fresnel;
 mod microfacet;
+mod perturbed;
 mod phong;
 
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
 pub use microfacet::{Microfacet, MicrofacetKind};
+pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
 pub use phong::Phong;
 
 use crate::math::{Rgb, Vec3, INV_PI};

@@ -78,6 +78,7 @@ pub fn read_mesh_file(
             let m = ply::read_ply(path)?;
             let normals = if face_normals { None } else { m.normals };
             let mesh = TriangleMesh::new(m.positions, normals, m.uvs, m.indices, split)
+                .and_then(|mesh| mesh.with_attributes(m.attributes))
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             Ok(vec![LoadedGroup::primitive(mesh)])
         }
@@ -105,7 +106,8 @@ pub(crate) fn bake(mesh: &TriangleMesh, to_world: &Transform, split: BvhSplit) -
     let normals = mesh.normals.as_ref().map(|ns| ns.iter().map(|&n| to_world.normal(n).normalize()).collect());
     // Indices are kept: as in Mitsuba, a mirroring transform reverses the winding and so
     // flips the face normal.
-    TriangleMesh::new(positions, normals, mesh.uvs.clone(), mesh.indices.clone(), split)
+    TriangleMesh::new(positions, normals, mesh.uvs.clone(), mesh.indices.clone(), split)?
+        .with_attributes(mesh.attributes.clone())
 }
 
 pub struct WorldBuilder {
@@ -340,6 +342,7 @@ impl WorldBuilder {
             light_selection: selection,
             bvh_split: self.split,
             bvh_build_seconds: 0.0,
+            has_masks: false,
         };
         scene.finish(selection);
         scene.bvh_build_seconds = self.build_seconds + start.elapsed().as_secs_f64();

@@ -10,7 +10,7 @@ use super::builder::{bake, environment_lights, read_mesh_file};
 use super::{add_light, camera, material_id, material_kind, mesh_loc, transform_of, validate, TextureCache};
 use super::{BuildOptions, LoadedGroup, WorldBuilder};
 use crate::accel::BvhSplit;
-use crate::describe::{Geometry, Matrix4, SceneDesc, ShapeDesc};
+use crate::describe::{Geometry, MaterialRef, Matrix4, SceneDesc, ShapeDesc};
 use crate::error::{Error, SourceLoc};
 use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, TriangleMesh};
 use crate::lights::Light;
@@ -204,6 +204,7 @@ fn add_shape(
             (Source::File { file: m.file.clone(), face_normals: m.face_normals, shape_index: 0 }, true)
         }
         Geometry::Sphere { center, radius } => {
+            check_attributes(desc, s, None)?;
             return Ok(b.add_sphere(*center, *radius, &to_world, material, s.emission, s.flip_normals)?);
         }
         g => (Source::Shape { index: place.index, geometry: geometry_hash(g) }, false),
@@ -226,6 +227,9 @@ fn add_shape(
         cache.groups.insert(source.clone(), vec![LoadedGroup::primitive(mesh)]);
     }
     let groups = cache.groups[&source].clone();
+    for g in &groups {
+        check_attributes(desc, s, Some(&g.mesh))?;
+    }
     used.groups.insert(source.clone());
     let instanced = instanced || place.instanced;
     for (group, g) in groups.iter().enumerate() {
@@ -251,6 +255,25 @@ fn add_shape(
             used.baked.insert(key);
             b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, m, s.emission, s.flip_normals)?;
         }
+    }
+    Ok(())
+}
+
+/// Every mesh attribute the shape's material reads must be one its mesh has (a sphere has
+/// none), with a value size a texture can use.
+fn check_attributes(desc: &SceneDesc, s: &ShapeDesc, mesh: Option<&TriangleMesh>) -> Result<(), Error> {
+    let MaterialRef::Index(i) = s.material else { return Ok(()) };
+    let Some(m) = desc.materials.get(i) else { return Ok(()) };
+    for (name, _) in m.model.mesh_attributes() {
+        if mesh.is_some_and(|mesh| mesh.attribute(name).is_some()) {
+            continue;
+        }
+        let have: Vec<&str> = mesh.map_or(vec![], |m| m.attributes.iter().map(|a| a.name.as_str()).collect());
+        let have = if have.is_empty() { "none".to_string() } else { have.join(", ") };
+        return Err(Error::new(format!(
+            "material '{}' reads mesh attribute '{name}', which this shape does not have (it has: {have})",
+            m.name
+        )));
     }
     Ok(())
 }
@@ -322,6 +345,7 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
     for (i, m) in materials.into_iter().enumerate() {
         world.materials[i] = m;
     }
+    world.has_masks = world.materials.iter().any(Material::is_masked);
     for (light, e) in emission {
         match &mut world.lights[light] {
             Light::Mesh { radiance, two_sided, .. } => {

@@ -83,6 +83,9 @@ impl TextureCache {
             TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {
                 Texture::Checkerboard { color0: *color0, color1: *color1, uv_scale: *uv_scale, uv_offset: *uv_offset }
             }
+            TextureDesc::MeshAttribute { name, scale, .. } => {
+                Texture::MeshAttribute { name: name.clone(), scale: *scale }
+            }
         })
     }
 }
@@ -113,6 +116,19 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
             Material::plastic(textures.texture(diffuse)?, *specular, *eta, roughness.as_ref().map(microfacet))
         }
         MaterialModel::Black => MaterialKind::Black,
+        MaterialModel::NormalMap { normals, nested } => MaterialKind::NormalMap {
+            normals: textures.texture(normals)?,
+            nested: Box::new(material_kind(nested, textures)?),
+        },
+        MaterialModel::BumpMap { height, scale, nested } => MaterialKind::BumpMap {
+            height: textures.texture(height)?,
+            scale: *scale,
+            nested: Box::new(material_kind(nested, textures)?),
+        },
+        MaterialModel::Mask { opacity, nested } => MaterialKind::Mask {
+            opacity: textures.texture(opacity)?,
+            nested: Box::new(material_kind(nested, textures)?),
+        },
     })
 }
 

@@ -137,6 +137,14 @@ fn material(m: &MaterialModel) -> Result<(), String> {
                 uv(uv_scale, uv_offset)?;
             }
             TextureDesc::Bitmap { uv_scale, uv_offset, .. } => uv(uv_scale, uv_offset)?,
+            TextureDesc::MeshAttribute { name, scale, .. } => {
+                if !scale.is_finite() {
+                    return Err(format!("mesh attribute '{name}': scale {scale} must be finite"));
+                }
+                if !(name.starts_with("vertex_") || name.starts_with("face_")) {
+                    return Err(format!("mesh attribute name '{name}' must start with 'vertex_' or 'face_'"));
+                }
+            }
         }
     }
     let alpha = |r: &Option<crate::describe::Roughness>| -> Result<(), String> {
@@ -179,6 +187,13 @@ fn material(m: &MaterialModel) -> Result<(), String> {
             alpha(roughness)?;
         }
         MaterialModel::Diffuse { .. } | MaterialModel::Black => {}
+        MaterialModel::BumpMap { scale, nested, .. } => {
+            if !scale.is_finite() {
+                return Err(format!("bump map scale {scale} must be finite"));
+            }
+            material(nested)?;
+        }
+        MaterialModel::NormalMap { nested, .. } | MaterialModel::Mask { nested, .. } => material(nested)?,
     }
     Ok(())
 }

@@ -140,6 +140,22 @@ pub enum MaterialModel {
     },
     /// Absorbs everything (emitters without a material).
     Black,
+    /// `nested` shaded with a tangent-space normal map (Mitsuba's `normalmap`).
+    NormalMap {
+        normals: TextureDesc,
+        nested: Box<MaterialModel>,
+    },
+    /// `nested` shaded with the normals of `scale` times a height texture (`bumpmap`).
+    BumpMap {
+        height: TextureDesc,
+        scale: f32,
+        nested: Box<MaterialModel>,
+    },
+    /// `nested` with an opacity: light passes through with probability 1 - opacity (`mask`).
+    Mask {
+        opacity: TextureDesc,
+        nested: Box<MaterialModel>,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -161,6 +177,14 @@ pub enum TextureDesc {
         color1: Rgb,
         uv_scale: [f32; 2],
         uv_offset: [f32; 2],
+    },
+    /// A per-vertex (`vertex_NAME`) or per-face (`face_NAME`) attribute of the mesh it is
+    /// used on, times `scale` (Mitsuba's `mesh_attribute`).
+    #[serde(rename = "mesh_attribute")]
+    MeshAttribute {
+        name: String,
+        scale: f32,
+        loc: SourceLoc,
     },
 }
 
@@ -394,6 +418,13 @@ impl MaterialModel {
             MaterialModel::Phong { kd, .. } => vec![kd],
             MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
             MaterialModel::Conductor { .. } | MaterialModel::Dielectric { .. } | MaterialModel::Black => vec![],
+            MaterialModel::NormalMap { normals: t, nested }
+            | MaterialModel::BumpMap { height: t, nested, .. }
+            | MaterialModel::Mask { opacity: t, nested } => {
+                let mut v = vec![t];
+                v.extend(nested.textures());
+                v
+            }
         }
     }
 
@@ -403,7 +434,25 @@ impl MaterialModel {
             MaterialModel::Phong { kd, .. } => vec![kd],
             MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
             MaterialModel::Conductor { .. } | MaterialModel::Dielectric { .. } | MaterialModel::Black => vec![],
+            MaterialModel::NormalMap { normals: t, nested }
+            | MaterialModel::BumpMap { height: t, nested, .. }
+            | MaterialModel::Mask { opacity: t, nested } => {
+                let mut v = vec![t];
+                v.extend(nested.textures_mut());
+                v
+            }
         }
+    }
+
+    /// The mesh attributes the material's textures read, with where each is named.
+    pub fn mesh_attributes(&self) -> Vec<(&str, &SourceLoc)> {
+        self.textures()
+            .into_iter()
+            .filter_map(|t| match t {
+                TextureDesc::MeshAttribute { name, loc, .. } => Some((name.as_str(), loc)),
+                _ => None,
+            })
+            .collect()
     }
 }
 

@@ -148,6 +148,12 @@ enum JsonTexture {
         #[serde(default)]
         uv_scale: Option<[f32; 2]>,
     },
+    /// A mesh attribute (`vertex_...` or `face_...`) of the shape the material is used on.
+    Attribute {
+        attribute: String,
+        #[serde(default)]
+        scale: Option<f32>,
+    },
 }
 
 #[derive(Deserialize)]
@@ -205,6 +211,17 @@ enum JsonMaterial {
         #[serde(default)]
         distribution: Option<String>,
     },
+    /// `material` shaded with a tangent-space normal map.
+    NormalMap { normals: JsonTexture, material: Box<JsonMaterial> },
+    /// `material` shaded with the normals of `scale` times a height texture.
+    BumpMap {
+        height: JsonTexture,
+        #[serde(default)]
+        scale: Option<f32>,
+        material: Box<JsonMaterial>,
+    },
+    /// `material` where opaque; light passes through with probability 1 - opacity.
+    Mask { opacity: JsonTexture, material: Box<JsonMaterial> },
 }
 
 #[derive(Deserialize)]
@@ -361,6 +378,9 @@ fn texture_of(ctx: &Ctx, json_path: &str, t: &JsonTexture) -> TextureDesc {
             uv_scale: uv_scale.unwrap_or([1.0, 1.0]),
             uv_offset: [0.0, 0.0],
         },
+        JsonTexture::Attribute { attribute, scale } => {
+            TextureDesc::MeshAttribute { name: attribute.clone(), scale: scale.unwrap_or(1.0), loc: ctx.loc(json_path) }
+        }
     }
 }
 
@@ -381,7 +401,48 @@ fn roughness(ctx: &Ctx, at: &str, name: &Option<String>, alpha: Option<f32>) -> 
 
 fn material_of(ctx: &Ctx, name: &str, m: &JsonMaterial) -> Result<MaterialDesc, Error> {
     let at = format!("materials/{name}");
-    let (model, two_sided) = match m {
+    let (model, two_sided) = material_model_of(ctx, name, &at, m)?;
+    Ok(MaterialDesc { name: name.to_string(), model, two_sided, loc: ctx.loc(&at) })
+}
+
+/// A material's model and whether it is two-sided; `at` is its JSON path.
+fn material_model_of(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(MaterialModel, bool), Error> {
+    let at = at.to_string();
+    let nested = |inner: &JsonMaterial| -> Result<(Box<MaterialModel>, bool), Error> {
+        let (model, two_sided) = material_model_of(ctx, name, &format!("{at}/material"), inner)?;
+        if matches!(model, MaterialModel::NormalMap { .. } | MaterialModel::BumpMap { .. })
+            && !matches!(m, JsonMaterial::Mask { .. })
+        {
+            return Err(
+                ctx.err(&at, format!("material '{name}': a normal or bump map inside another one is not supported"))
+            );
+        }
+        Ok((Box::new(model), two_sided))
+    };
+    Ok(match m {
+        JsonMaterial::NormalMap { normals, material } => {
+            let (nested, two_sided) = nested(material)?;
+            (
+                MaterialModel::NormalMap { normals: texture_of(ctx, &format!("{at}/normals"), normals), nested },
+                two_sided,
+            )
+        }
+        JsonMaterial::BumpMap { height, scale, material } => {
+            let (nested, two_sided) = nested(material)?;
+            let height = texture_of(ctx, &format!("{at}/height"), height);
+            (MaterialModel::BumpMap { height, scale: scale.unwrap_or(1.0), nested }, two_sided)
+        }
+        JsonMaterial::Mask { opacity, material } => {
+            let (nested, two_sided) = nested(material)?;
+            (MaterialModel::Mask { opacity: texture_of(ctx, &format!("{at}/opacity"), opacity), nested }, two_sided)
+        }
+        _ => material_plain(ctx, name, &at, m)?,
+    })
+}
+
+fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(MaterialModel, bool), Error> {
+    let at = at.to_string();
+    Ok(match m {
         JsonMaterial::Diffuse { reflectance, two_sided } => (
             MaterialModel::Diffuse { reflectance: texture_of(ctx, &format!("{at}/reflectance"), reflectance) },
             two_sided.unwrap_or(true),
@@ -433,8 +494,10 @@ fn material_of(ctx: &Ctx, name: &str, m: &JsonMaterial) -> Result<MaterialDesc, 
             },
             true,
         ),
-    };
-    Ok(MaterialDesc { name: name.to_string(), model, two_sided, loc: ctx.loc(&at) })
+        JsonMaterial::NormalMap { .. } | JsonMaterial::BumpMap { .. } | JsonMaterial::Mask { .. } => {
+            return material_model_of(ctx, name, &at, m)
+        }
+    })
 }
 
 /// Reads a JSON scene (`text` is the file's contents) into a description.

@@ -1,5 +1,6 @@
 //! Triangle meshes with their own bottom-level BVH.
 
+use super::MeshAttribute;
 use crate::accel::{
     intersect_triangle, BuildOptions, Bvh, BvhSplit, ShearedRay, SimdPath, TriangleHit, TriangleWideBvh, WideStats,
 };
@@ -50,6 +51,9 @@ pub struct TriangleMesh {
     pub bvh: Bvh,
     /// The wide BVH that `intersect` and `occluded` use, when built.
     pub wide: WideTris,
+    /// Named per-vertex and per-face attributes (PLY colours and the like), for the
+    /// `mesh_attribute` texture; set with [`TriangleMesh::with_attributes`].
+    pub attributes: Vec<MeshAttribute>,
 }
 
 impl TriangleMesh {
@@ -78,9 +82,38 @@ impl TriangleMesh {
         if let Some(p) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("vertex {p} is not finite"));
         }
-        let mut mesh = TriangleMesh { positions, normals, uvs, indices, bvh: Bvh::default(), wide: WideTris::None };
+        let mut mesh = TriangleMesh {
+            positions,
+            normals,
+            uvs,
+            indices,
+            bvh: Bvh::default(),
+            wide: WideTris::None,
+            attributes: Vec::new(),
+        };
         mesh.build_bvh(split);
         Ok(mesh)
+    }
+
+    /// The mesh with these attributes; an error names one whose size does not match the
+    /// mesh's vertex or face count.
+    pub fn with_attributes(mut self, attributes: Vec<MeshAttribute>) -> Result<TriangleMesh, String> {
+        for a in &attributes {
+            let want = a.expected_len(self.positions.len(), self.indices.len());
+            if a.values.len() != want || !(a.dim == 1 || a.dim == 3) {
+                return Err(format!("attribute '{}' has {} values, expected {want}", a.name, a.values.len()));
+            }
+            if let Some(i) = a.values.iter().position(|v| !v.is_finite()) {
+                return Err(format!("attribute '{}': value {i} is not finite", a.name));
+            }
+        }
+        self.attributes = attributes;
+        Ok(self)
+    }
+
+    /// The attribute called `name`, if the mesh has it.
+    pub fn attribute(&self, name: &str) -> Option<&MeshAttribute> {
+        self.attributes.iter().find(|a| a.name == name)
     }
 
     pub fn build_bvh(&mut self, split: BvhSplit) {

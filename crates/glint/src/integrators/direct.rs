@@ -10,6 +10,7 @@
 //! lights come out emitter_samples times too bright there; here every light sample counts
 //! 1/emitter_samples.
 
+use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::DirectSettings;
 use crate::math::{Ray, Rgb};
@@ -17,21 +18,36 @@ use crate::sampling::{power_heuristic, Sampler};
 use crate::world::World;
 
 pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
-    let Some((ray, hit)) = camera_hit(scene, camera_ray, s.hide_emitters, c) else {
-        if s.hide_emitters {
-            return Rgb::BLACK;
-        }
-        return scene
-            .environment_lights
-            .iter()
-            .fold(Rgb::BLACK, |l, &i| l + scene.lights[i as usize].environment(camera_ray.dir));
-    };
-    let si = scene.interaction(&ray, &hit);
     let mut l = Rgb::BLACK;
-    if let Some(li_idx) = si.light {
-        // Only reached when emitters are shown (`camera_hit` looks through them otherwise).
-        l += scene.lights[li_idx as usize].emitted(si.ng, ray.dir);
-    }
+    let mut camera_ray = *camera_ray;
+    let mut passes = 0;
+    // The camera ray passes a masked surface with probability 1 - opacity (adding what the
+    // surface emits), as the path tracer does.
+    let (ray, si) = loop {
+        let Some((ray, hit)) = camera_hit(scene, &camera_ray, s.hide_emitters, c) else {
+            if s.hide_emitters {
+                return l;
+            }
+            return scene
+                .environment_lights
+                .iter()
+                .fold(l, |l, &i| l + scene.lights[i as usize].environment(camera_ray.dir));
+        };
+        let si = scene.interaction(&ray, &hit);
+        if let Some(li_idx) = si.light {
+            // Only reached when emitters are shown (`camera_hit` looks through them otherwise).
+            l += scene.lights[li_idx as usize].emitted(si.ng, ray.dir);
+        }
+        if scene.has_masks && passes < MAX_MASK_PASSES {
+            let o = opacity(scene, &si);
+            if o < 1.0 && rng.next_f32() >= o {
+                passes += 1;
+                camera_ray = spawn_ray(&si, ray.dir);
+                continue;
+            }
+        }
+        break (ray, si);
+    };
     let wo_world = -ray.dir;
     let (bsdf, frame) = shading(scene, &si, wo_world);
     let wo = frame.to_local(wo_world);
@@ -55,12 +71,13 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                     continue;
                 }
                 c.shadow_rays += 1;
-                if scene.occluded(&shadow_ray(&si, ls.wi, ls.dist)) {
+                let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
+                if !(visible > 0.0) {
                     continue;
                 }
                 let light_pdf = pick.pmf * ls.pdf;
                 let w = if ls.delta { 1.0 } else { power_heuristic(n_e * light_pdf, n_b * bsdf.pdf(wo, wi)) };
-                l += f * ls.radiance * (w / (n_e * light_pdf));
+                l += f * ls.radiance * (w * visible / (n_e * light_pdf));
             }
         }
     }
@@ -83,27 +100,37 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
             let w = if bs.delta { 1.0 } else { power_heuristic(n_b * bs.pdf, n_e * light_pdf) };
             bs.weight * (w / n_b)
         };
-        match scene.intersect(&ray) {
-            Some(hit) => {
-                let sj = scene.interaction(&ray, &hit);
-                let Some(li_idx) = sj.light else { continue };
-                let light = &scene.lights[li_idx as usize];
-                let le = light.emitted(sj.ng, ray.dir);
-                if le.is_black() {
-                    continue;
-                }
-                let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, sj.p, sj.ng);
-                l += weight(light_pdf) * le;
-            }
-            None => {
-                for &li_idx in &scene.environment_lights {
-                    let light = &scene.lights[li_idx as usize];
-                    let le = light.environment(ray.dir);
-                    if le.is_black() {
-                        continue;
+        // Masked surfaces on the way pass a fraction 1 - opacity of what lies behind them.
+        let (mut ray, mut through) = (ray, 1.0f32);
+        for _ in 0..=MAX_MASK_PASSES {
+            match scene.intersect(&ray) {
+                Some(hit) => {
+                    let sj = scene.interaction(&ray, &hit);
+                    if let Some(li_idx) = sj.light {
+                        let light = &scene.lights[li_idx as usize];
+                        let le = light.emitted(sj.ng, ray.dir);
+                        if !le.is_black() {
+                            let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, sj.p, sj.ng);
+                            l += weight(light_pdf) * le * through;
+                        }
                     }
-                    let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, ray.origin, ray.dir);
-                    l += weight(light_pdf) * le;
+                    through *= 1.0 - if scene.has_masks { opacity(scene, &sj) } else { 1.0 };
+                    if !(through > 0.0) {
+                        break;
+                    }
+                    ray = spawn_ray(&sj, ray.dir);
+                }
+                None => {
+                    for &li_idx in &scene.environment_lights {
+                        let light = &scene.lights[li_idx as usize];
+                        let le = light.environment(ray.dir);
+                        if le.is_black() {
+                            continue;
+                        }
+                        let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, ray.origin, ray.dir);
+                        l += weight(light_pdf) * le * through;
+                    }
+                    break;
                 }
             }
         }

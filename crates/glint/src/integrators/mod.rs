@@ -6,12 +6,13 @@
 mod direct;
 mod first_hit;
 mod path;
+mod surface;
 mod whitted;
 
 pub use crate::describe::{DirectSettings, PathSettings, Strategy, WhittedSettings};
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::ShadedBsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::sampling::Sampler;
 use crate::world::{Hit, SurfaceInteraction, World};
@@ -61,15 +62,10 @@ impl Integrator {
 
 /// The BSDF at a hit and the frame to evaluate it in. Two-sided opaque materials turn
 /// their frame to face the viewer; one-sided ones (Mitsuba's default) keep it, so their back
-/// face is black; dielectrics keep it, since which side is inside matters to them.
-pub(crate) fn shading(scene: &World, si: &SurfaceInteraction, wo_world: Vec3) -> (Bsdf, Frame) {
-    let mat = &scene.materials[si.material as usize];
-    let bsdf = mat.bsdf(si.uv);
-    let mut frame = si.frame;
-    if mat.two_sided && !mat.is_transmissive() && frame.n.dot(wo_world) < 0.0 {
-        frame = Frame { s: frame.s, t: -frame.t, n: -frame.n };
-    }
-    (bsdf, frame)
+/// face is black; dielectrics keep it, since which side is inside matters to them. Normal
+/// and bump maps tilt the BSDF within that frame (see `surface`).
+pub(crate) fn shading(scene: &World, si: &SurfaceInteraction, wo_world: Vec3) -> (ShadedBsdf, Frame) {
+    surface::shade(scene, si, wo_world)
 }
 
 /// The most emitters a camera ray looks through when they are hidden; one that meets more

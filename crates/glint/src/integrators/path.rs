@@ -3,6 +3,7 @@
 //! by default. Depth counts path segments, as Mitsuba's `max_depth` does: 1 shows emitters
 //! seen directly, 2 adds direct lighting, and so on.
 
+use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
 
@@ -32,6 +33,7 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
     let mut prev_delta = true;
     let mut prev_p = ray.origin;
     let mut depth = 0u32; // segments traced so far
+    let mut mask_passes = 0u32;
 
     loop {
         let hit = if depth == 0 {
@@ -75,6 +77,18 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
                 }
             }
         }
+        // A masked surface lets the path through unscattered with probability 1 - opacity.
+        // Passing is not a bounce: depth, the MIS state and the previous vertex stay as
+        // they were (shadow rays from that vertex crossed the surface the same way).
+        if scene.has_masks && mask_passes < MAX_MASK_PASSES {
+            let o = opacity(scene, &si);
+            if o < 1.0 && rng.next_f32() >= o {
+                mask_passes += 1;
+                depth -= 1;
+                ray = spawn_ray(&si, ray.dir);
+                continue;
+            }
+        }
         if depth >= max_depth {
             break;
         }
@@ -95,14 +109,15 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
                         let f = bsdf.eval(wo, wi);
                         if !f.is_black() {
                             c.shadow_rays += 1;
-                            if !scene.occluded(&shadow_ray(&si, ls.wi, ls.dist)) {
+                            let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
+                            if visible > 0.0 {
                                 let light_pdf = pick.pmf * ls.pdf;
                                 let w = if ls.delta || s.strategy == Strategy::Light {
                                     1.0
                                 } else {
                                     power_heuristic(light_pdf, bsdf.pdf(wo, wi))
                                 };
-                                l += throughput * f * ls.radiance * (w / light_pdf);
+                                l += throughput * f * ls.radiance * (w * visible / light_pdf);
                             }
                         }
                     }

@@ -118,7 +118,7 @@ fn shade(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
     let wo = frame.to_local(wo_world);
     let can_recurse = depth < s.max_depth;
 
-    match bsdf {
+    match bsdf.bsdf {
         Bsdf::Dielectric { eta, reflect, transmit } => {
             if can_recurse {
                 let fr = fresnel_dielectric(wo.z, eta);
@@ -205,7 +205,7 @@ mod tests {
         let wo = frame.to_local(wo_world);
         let can_recurse = depth < s.max_depth;
 
-        match bsdf {
+        match bsdf.bsdf {
             Bsdf::Dielectric { eta, reflect, transmit } => {
                 if can_recurse {
                     let fr = fresnel_dielectric(wo.z, eta);

@@ -4,6 +4,7 @@ pub mod image_io;
 pub mod layers;
 pub mod obj;
 pub mod ply;
+mod ply_attributes;
 pub mod serialized;
 mod texture_file;
 

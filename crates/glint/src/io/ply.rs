@@ -2,6 +2,8 @@
 //! and texture coordinates, and faces as lists (fan-triangulated). Errors name the file and,
 //! for the header and ASCII bodies, the line.
 
+use super::ply_attributes::{attribute_layout, AttributeReader};
+use crate::geometry::{AttributeScope, MeshAttribute};
 use crate::math::Vec3;
 use std::path::Path;
 
@@ -15,6 +17,9 @@ pub struct PlyMesh {
     pub normals: Option<Vec<Vec3>>,
     pub uvs: Option<Vec<[f32; 2]>>,
     pub indices: Vec<[u32; 3]>,
+    /// Per-vertex and per-face attributes, named as Mitsuba names them (`vertex_color`, ...);
+    /// a face attribute has one value per triangle (a polygon's value repeated).
+    pub attributes: Vec<MeshAttribute>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -162,6 +167,13 @@ impl Reader<'_> {
     }
 }
 
+/// Stands in for list properties among an element's property names: never an attribute.
+const LIST: &str = "\0list";
+
+fn prop_names(el: &Element) -> Vec<&str> {
+    el.props.iter().map(|pr| if pr.list.is_some() { LIST } else { pr.name.as_str() }).collect()
+}
+
 pub fn read_ply(path: &Path) -> Result<PlyMesh, String> {
     let data = super::read_file_bounded(path, super::MAX_MESH_FILE_BYTES)?;
     parse_ply(&data, path)
@@ -268,6 +280,15 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                 };
                 let (nx, ny, nz) = (idx(&["nx"]), idx(&["ny"]), idx(&["nz"]));
                 let (u, v) = (idx(&["u", "s", "texture_u", "texture_s"]), idx(&["v", "t", "texture_v", "texture_t"]));
+                let mut reserved = vec!["x", "y", "z", "nx", "ny", "nz", LIST];
+                for k in [u, v].into_iter().flatten() {
+                    reserved.push(el.props[k].name.as_str());
+                }
+                let mut attrs = AttributeReader::new(
+                    attribute_layout(&prop_names(el), &reserved, "vertex_"),
+                    AttributeScope::Vertex,
+                );
+                let mut attr_vals = vec![0.0f32; el.props.len()];
                 let mut vals = vec![0.0f64; el.props.len()];
                 for _ in 0..el.count {
                     for (k, pr) in el.props.iter().enumerate() {
@@ -278,8 +299,10 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                             }
                         } else {
                             vals[k] = r.read(pr.ty, path)?;
+                            attr_vals[k] = vals[k] as f32;
                         }
                     }
+                    attrs.push(&attr_vals, 1);
                     mesh.positions.push(Vec3 { x: vals[x] as f32, y: vals[y] as f32, z: vals[z] as f32 });
                     if let (Some(a), Some(b), Some(c)) = (nx, ny, nz) {
                         normals.push(Vec3 { x: vals[a] as f32, y: vals[b] as f32, z: vals[c] as f32 });
@@ -289,6 +312,7 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                         uvs.push([vals[a] as f32, 1.0 - vals[b] as f32]);
                     }
                 }
+                mesh.attributes.extend(attrs.finish());
             }
             "face" => {
                 let list = el
@@ -296,7 +320,11 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                     .iter()
                     .position(|pr| pr.list.is_some() && (pr.name == "vertex_indices" || pr.name == "vertex_index"))
                     .ok_or_else(|| format!("{p}: face element has no vertex_indices list"))?;
+                let mut attrs =
+                    AttributeReader::new(attribute_layout(&prop_names(el), &[LIST], "face_"), AttributeScope::Face);
+                let mut attr_vals = vec![0.0f32; el.props.len()];
                 for f in 0..el.count {
+                    let triangles_before = mesh.indices.len();
                     for (k, pr) in el.props.iter().enumerate() {
                         if let Some(ct) = pr.list {
                             let n = r.read_count(ct, pr.ty, path)?;
@@ -322,10 +350,12 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                                 }
                             }
                         } else {
-                            r.read(pr.ty, path)?;
+                            attr_vals[k] = r.read(pr.ty, path)? as f32;
                         }
                     }
+                    attrs.push(&attr_vals, mesh.indices.len() - triangles_before);
                 }
+                mesh.attributes.extend(attrs.finish());
             }
             _ => {
                 for _ in 0..el.count {
@@ -385,6 +415,27 @@ mod tests {
         // Truncated: drop the last index.
         let e = parse_ply(&data[..data.len() - 2], Path::new("b.ply")).unwrap_err();
         assert!(e.contains("b.ply") && e.contains("truncated"), "{e}");
+    }
+
+    #[test]
+    fn colours_become_mitsubas_attributes() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nproperty uchar r\nproperty uchar g\nproperty uchar b\nend_header\n0 0 0 0.1 0.2 128 0 255\n1 0 0 0.3 0.4 10 20 30\n0 1 0 0.5 0.6 1 2 3\n3 0 1 2 128 64 255\n";
+        let m = parse_ply(text.as_bytes(), Path::new("c.ply")).unwrap();
+        let get = |n: &str| m.attributes.iter().find(|a| a.name == n).unwrap();
+        // As Mitsuba 3.9.1 stores them (read back with mi.traverse): integers unscaled.
+        assert_eq!(get("vertex_color").values, vec![128.0, 0.0, 255.0, 10.0, 20.0, 30.0, 1.0, 2.0, 3.0]);
+        assert_eq!(get("face_color").values, vec![128.0, 64.0, 255.0]);
+        assert_eq!(get("face_color").scope, AttributeScope::Face);
+        // A quad's face attribute covers both its triangles.
+        let quad = ASCII
+            .replace(
+                "property list uchar int vertex_indices",
+                "property list uchar int vertex_indices\nproperty float w_x",
+            )
+            .replace("4 0 1 2 3", "4 0 1 2 3 0.5");
+        let m = parse_ply(quad.as_bytes(), Path::new("q.ply")).unwrap();
+        assert_eq!(m.attributes[0].name, "face_w");
+        assert_eq!(m.attributes[0].values, vec![0.5, 0.5]);
     }
 
     #[test]

@@ -2,8 +2,10 @@
 //! evaluates the textures at a hit point and returns the [`Bsdf`] to scatter with.
 
 mod conductor_presets;
+mod surface;
 mod texture;
-pub use texture::{Bitmap, Texture};
+pub use surface::Perturbation;
+pub use texture::{Bitmap, Texture, TexturePoint};
 
 use crate::bsdf::{Bsdf, Microfacet, Phong, PlasticParams};
 use crate::math::Rgb;
@@ -52,6 +54,25 @@ pub enum MaterialKind {
         params: PlasticParams,
     },
     Black,
+    /// `nested`, shaded in a frame tilted by a tangent-space normal map (Mitsuba's
+    /// `normalmap`): the texture's RGB in [0, 1] is the normal's xyz in [-1, 1].
+    NormalMap {
+        normals: Texture,
+        nested: Box<MaterialKind>,
+    },
+    /// `nested`, shaded in a frame tilted by the gradient of `scale` times a height texture
+    /// (Mitsuba's `bumpmap`).
+    BumpMap {
+        height: Texture,
+        scale: f32,
+        nested: Box<MaterialKind>,
+    },
+    /// `nested` where a surface point is opaque, which it is with probability `opacity`
+    /// (clamped to [0, 1]); light passes straight through otherwise (Mitsuba's `mask`).
+    Mask {
+        opacity: Texture,
+        nested: Box<MaterialKind>,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -75,7 +96,7 @@ impl Material {
     /// True for materials that let light through (both faces are meaningful).
     pub fn is_transmissive(&self) -> bool {
         matches!(
-            self.kind,
+            self.kind.base(),
             MaterialKind::Dielectric { .. }
                 | MaterialKind::RoughDielectric { .. }
                 | MaterialKind::ThinDielectric { .. }
@@ -85,7 +106,7 @@ impl Material {
     /// The reflectance a denoiser wants as its albedo guide: the diffuse texture where
     /// there is one, the specular tint of metals, the transmission tint of dielectrics.
     pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
-        match &self.kind {
+        match self.kind.base() {
             MaterialKind::Diffuse { reflectance } => reflectance.eval(uv),
             MaterialKind::Phong { kd, ks, .. } => (kd.eval(uv) + *ks).map(|v| v.min(1.0)),
             MaterialKind::Conductor { specular, .. } | MaterialKind::RoughConductor { specular, .. } => *specular,
@@ -93,16 +114,23 @@ impl Material {
             | MaterialKind::RoughDielectric { transmit, .. }
             | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
             MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
-            MaterialKind::Black => Rgb::BLACK,
+            _ => Rgb::BLACK,
         }
     }
 
     #[inline]
     pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {
-        match &self.kind {
-            MaterialKind::Diffuse { reflectance } => Bsdf::Diffuse { reflectance: reflectance.eval(uv) },
+        self.bsdf_at(&TexturePoint::uv(uv))
+    }
+
+    /// The BSDF at a hit point (of the innermost material, inside normal maps, bump maps and
+    /// masks: those are applied by the integrators, see [`Perturbation`]).
+    #[inline]
+    pub fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
+        match self.kind.base() {
+            MaterialKind::Diffuse { reflectance } => Bsdf::Diffuse { reflectance: reflectance.eval_at(p) },
             MaterialKind::Phong { kd, ks, exponent } => {
-                Bsdf::Phong(Phong { kd: kd.eval(uv), ks: *ks, exponent: *exponent })
+                Bsdf::Phong(Phong { kd: kd.eval_at(p), ks: *ks, exponent: *exponent })
             }
             MaterialKind::Conductor { eta, k, specular } => Bsdf::Conductor { eta: *eta, k: *k, specular: *specular },
             MaterialKind::RoughConductor { dist, eta, k, specular } => {
@@ -118,9 +146,12 @@ impl Material {
                 Bsdf::ThinDielectric { eta: *eta, reflect: *reflect, transmit: *transmit }
             }
             MaterialKind::Plastic { diffuse, params } => {
-                Bsdf::Plastic(PlasticParams { diffuse: diffuse.eval(uv), ..*params })
+                Bsdf::Plastic(PlasticParams { diffuse: diffuse.eval_at(p), ..*params })
             }
-            MaterialKind::Black => Bsdf::Black,
+            MaterialKind::Black
+            | MaterialKind::NormalMap { .. }
+            | MaterialKind::BumpMap { .. }
+            | MaterialKind::Mask { .. } => Bsdf::Black,
         }
     }
 }

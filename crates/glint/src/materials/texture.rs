@@ -1,7 +1,26 @@
-//! Textures: a colour as a function of surface uv.
+//! Textures: a colour as a function of surface uv (and, for mesh attributes, of the hit
+//! triangle).
 
+use crate::geometry::TriangleMesh;
 use crate::math::Rgb;
 use std::sync::Arc;
+
+/// Where a texture is looked up: the uv, and for mesh attributes the triangle hit, its
+/// barycentrics and its mesh (none for spheres).
+#[derive(Clone, Copy, Debug)]
+pub struct TexturePoint<'a> {
+    pub uv: [f32; 2],
+    pub prim: u32,
+    pub bary: [f32; 2],
+    pub mesh: Option<&'a TriangleMesh>,
+}
+
+impl TexturePoint<'_> {
+    /// A point known only by its uv (no mesh attributes).
+    pub fn uv(uv: [f32; 2]) -> TexturePoint<'static> {
+        TexturePoint { uv, prim: 0, bary: [0.0, 0.0], mesh: None }
+    }
+}
 
 /// An RGB image in linear space, sampled with bilinear filtering and wrap-around.
 #[derive(Clone, Debug)]
@@ -38,6 +57,21 @@ impl Bitmap {
         a * (1.0 - fy) + b * fy
     }
 
+    /// The gradient of the luminance of [`Bitmap::eval`] in (u, v): the exact derivative of
+    /// the bilinear interpolation (as Mitsuba's `eval_1_grad`), for bump maps.
+    pub fn luminance_gradient(&self, uv: [f32; 2]) -> [f32; 2] {
+        let x = uv[0] * self.width as f32 - 0.5;
+        let y = uv[1] * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let f = |dx: i64, dy: i64| self.texel(x0 + dx, y0 + dy).luminance();
+        let (f00, f10, f01, f11) = (f(0, 0), f(1, 0), f(0, 1), f(1, 1));
+        let dfdx = (1.0 - fy) * (f10 - f00) + fy * (f11 - f01);
+        let dfdy = (1.0 - fx) * (f01 - f00) + fx * (f11 - f10);
+        [dfdx * self.width as f32, dfdy * self.height as f32]
+    }
+
     pub fn mean(&self) -> Rgb {
         let s = self.pixels.iter().fold(Rgb::BLACK, |a, &p| a + p);
         s / self.pixels.len().max(1) as f32
@@ -60,9 +94,44 @@ pub enum Texture {
         uv_scale: [f32; 2],
         uv_offset: [f32; 2],
     },
+    /// A per-vertex or per-face attribute of the mesh hit (Mitsuba's `mesh_attribute`),
+    /// times `scale`; black where the shape has no such attribute (the build checks that
+    /// every shape using one has it).
+    MeshAttribute {
+        name: String,
+        scale: f32,
+    },
 }
 
 impl Texture {
+    /// The value at a hit point: as [`Texture::eval`], and mesh attributes from the mesh.
+    #[inline]
+    pub fn eval_at(&self, p: &TexturePoint) -> Rgb {
+        match self {
+            Texture::MeshAttribute { name, scale } => {
+                let Some(mesh) = p.mesh else { return Rgb::BLACK };
+                let (Some(a), Some(tri)) = (mesh.attribute(name), mesh.indices.get(p.prim as usize)) else {
+                    return Rgb::BLACK;
+                };
+                a.eval(*tri, p.prim, p.bary) * *scale
+            }
+            _ => self.eval(p.uv),
+        }
+    }
+
+    /// The gradient in (u, v) of the texture's luminance, for bump maps: exact for bitmaps,
+    /// zero for the piecewise-constant and constant ones.
+    pub fn luminance_gradient(&self, uv: [f32; 2]) -> [f32; 2] {
+        match self {
+            Texture::Bitmap { image, uv_scale, uv_offset } => {
+                let g =
+                    image.luminance_gradient([uv[0] * uv_scale[0] + uv_offset[0], uv[1] * uv_scale[1] + uv_offset[1]]);
+                [g[0] * uv_scale[0], g[1] * uv_scale[1]]
+            }
+            _ => [0.0, 0.0],
+        }
+    }
+
     #[inline]
     pub fn eval(&self, uv: [f32; 2]) -> Rgb {
         match self {
@@ -81,6 +150,8 @@ impl Texture {
                     *color1
                 }
             }
+            // Needs the hit triangle: see `eval_at`.
+            Texture::MeshAttribute { .. } => Rgb::BLACK,
         }
     }
 
@@ -90,6 +161,7 @@ impl Texture {
             Texture::Constant(c) => *c,
             Texture::Bitmap { image, .. } => image.mean(),
             Texture::Checkerboard { color0, color1, .. } => (*color0 + *color1) * 0.5,
+            Texture::MeshAttribute { scale, .. } => Rgb::splat(0.5 * scale),
         }
     }
 }

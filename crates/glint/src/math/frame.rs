@@ -18,6 +18,18 @@ impl Frame {
         let t = vec3(b, sign + n.y * n.y * a, -n.y);
         Frame { s, t, n }
     }
+    /// A frame around the unit normal `n` whose `s` is `tangent` made orthogonal to `n`
+    /// (Gram-Schmidt), as Mitsuba builds its shading frame from dp/du; where the tangent is
+    /// zero, not finite or parallel to `n`, the frame of [`Frame::from_normal`].
+    pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Frame {
+        let s = tangent - n * n.dot(tangent);
+        let len2 = s.length_squared();
+        if !(len2 > 1e-20 * tangent.length_squared()) || !len2.is_finite() {
+            return Frame::from_normal(n);
+        }
+        let s = s / len2.sqrt();
+        Frame { s, t: n.cross(s), n }
+    }
     #[inline(always)]
     pub fn to_local(&self, v: Vec3) -> Vec3 {
         vec3(v.dot(self.s), v.dot(self.t), v.dot(self.n))

@@ -126,6 +126,16 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
             roughness_slots(roughness, &mut out);
         }
         MaterialModel::Black => {}
+        // The wrapped material's parameters, and a mask's constant opacity.
+        MaterialModel::NormalMap { nested, .. } => return material_slots(nested),
+        MaterialModel::BumpMap { scale, nested, .. } => {
+            out.push(("bump_scale", Slot::Float(scale)));
+            out.extend(material_slots(nested));
+        }
+        MaterialModel::Mask { opacity, nested } => {
+            texture_slot("opacity", opacity, &mut out);
+            out.extend(material_slots(nested));
+        }
     }
     out
 }

@@ -57,6 +57,16 @@ pub struct SurfaceInteraction {
     pub material: u32,
     pub light: Option<u32>,
     pub t: f32,
+    /// Position derivatives along the surface's uv (world space, not normalised), as Mitsuba
+    /// defines them: from the triangle's uvs (its barycentrics when the mesh has none), the
+    /// sphere's spherical coordinates. The shading frame's `s` is `dpdu` made orthogonal to
+    /// the shading normal, as in Mitsuba, so tangent-space normal maps agree.
+    pub dpdu: Vec3,
+    pub dpdv: Vec3,
+    /// The hit primitive (triangle index; 0 for spheres) and its barycentrics (b1, b2), for
+    /// per-vertex and per-face mesh attributes.
+    pub prim: u32,
+    pub bary: [f32; 2],
 }
 
 pub struct World {
@@ -75,6 +85,8 @@ pub struct World {
     pub(crate) light_selection: LightSelection,
     pub(crate) bvh_split: BvhSplit,
     pub(crate) bvh_build_seconds: f64,
+    /// Some material has a mask (`mask`): shadow rays then look past what they hit.
+    pub(crate) has_masks: bool,
 }
 
 impl World {
@@ -97,6 +109,7 @@ impl World {
             .collect();
         self.top = TopLevelBvh::build_flattening(&boxes, self.bvh_split, &flat);
         self.bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+        self.has_masks = self.materials.iter().any(Material::is_masked);
         self.set_light_selection(selection);
     }
 
@@ -232,7 +245,7 @@ impl World {
     /// The full surface interaction for a hit found along `ray`.
     pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
         let inst = &self.instances[hit.instance as usize];
-        let (p, mut ng, mut ns, uv) = match inst.shape {
+        let (p, mut ng, mut ns, uv, dpdu, dpdv) = match inst.shape {
             ShapeRef::Mesh(m) => {
                 let mesh = &self.meshes[m as usize];
                 let tri = hit.prim as usize;
@@ -245,17 +258,26 @@ impl World {
                     .normals
                     .as_ref()
                     .map(|n| n[i0 as usize] * b0 + n[i1 as usize] * hit.b1 + n[i2 as usize] * hit.b2);
-                let uv = mesh.uvs.as_ref().map_or([hit.b1, hit.b2], |t| {
-                    let (t0, t1, t2) = (t[i0 as usize], t[i1 as usize], t[i2 as usize]);
-                    [t0[0] * b0 + t1[0] * hit.b1 + t2[0] * hit.b2, t0[1] * b0 + t1[1] * hit.b1 + t2[1] * hit.b2]
-                });
+                let (uv, dpdu, dpdv) = match mesh.uvs.as_ref() {
+                    None => ([hit.b1, hit.b2], b - a, c - a),
+                    Some(t) => {
+                        let (t0, t1, t2) = (t[i0 as usize], t[i1 as usize], t[i2 as usize]);
+                        let uv = [
+                            t0[0] * b0 + t1[0] * hit.b1 + t2[0] * hit.b2,
+                            t0[1] * b0 + t1[1] * hit.b1 + t2[1] * hit.b2,
+                        ];
+                        let (dpdu, dpdv) = triangle_dpduv([a, b, c], [t0, t1, t2], ng_obj);
+                        (uv, dpdu, dpdv)
+                    }
+                };
                 match &inst.to_world {
-                    None => (p_obj, ng_obj, ns_obj, uv),
+                    None => (p_obj, ng_obj, ns_obj, uv, dpdu, dpdv),
                     Some(t) => {
                         // Orientation follows the winding in world space, as when vertices
                         // are transformed: a mirroring transform flips the normal.
                         let flip = if t.swaps_handedness() { -1.0 } else { 1.0 };
-                        (t.point(p_obj), t.normal(ng_obj) * flip, ns_obj.map(|n| t.normal(n)), uv)
+                        let ns = ns_obj.map(|n| t.normal(n));
+                        (t.point(p_obj), t.normal(ng_obj) * flip, ns, uv, t.vector(dpdu), t.vector(dpdv))
                     }
                 }
             }
@@ -271,7 +293,8 @@ impl World {
                 if phi < 0.0 {
                     phi += 2.0 * std::f32::consts::PI;
                 }
-                (p, n, None, [phi / (2.0 * std::f32::consts::PI), theta / std::f32::consts::PI])
+                let (dpdu, dpdv) = sphere_dpduv(local, sph.radius);
+                (p, n, None, [phi / (2.0 * std::f32::consts::PI), theta / std::f32::consts::PI], dpdu, dpdv)
             }
         };
         ng = ng.normalize();
@@ -295,12 +318,16 @@ impl World {
         SurfaceInteraction {
             p,
             ng,
-            frame: Frame::from_normal(n_shading),
+            frame: Frame::from_normal_tangent(n_shading, dpdu),
             uv,
             instance: hit.instance,
             material: inst.material,
             light: inst.light,
             t: hit.t,
+            dpdu,
+            dpdv,
+            prim: hit.prim,
+            bary: [hit.b1, hit.b2],
         }
     }
 
@@ -348,4 +375,38 @@ impl World {
             })
             .sum()
     }
+}
+
+/// dp/du and dp/dv of a triangle from its uvs, as Mitsuba computes them; where the uvs are
+/// degenerate (zero determinant, or a non-finite result), an arbitrary tangent basis of the
+/// face normal `ng` (not normalised), as Mitsuba falls back to.
+fn triangle_dpduv(p: [Vec3; 3], t: [[f32; 2]; 3], ng: Vec3) -> (Vec3, Vec3) {
+    let (dp0, dp1) = (p[1] - p[0], p[2] - p[0]);
+    let (du0, dv0) = (t[1][0] - t[0][0], t[1][1] - t[0][1]);
+    let (du1, dv1) = (t[2][0] - t[0][0], t[2][1] - t[0][1]);
+    let det = du0 * dv1 - dv0 * du1;
+    if det != 0.0 {
+        let inv = 1.0 / det;
+        let dpdu = (dp0 * dv1 - dp1 * dv0) * inv;
+        let dpdv = (dp1 * du0 - dp0 * du1) * inv;
+        if dpdu.is_finite() && dpdv.is_finite() {
+            return (dpdu, dpdv);
+        }
+    }
+    let f = Frame::from_normal(ng.normalize());
+    (f.s, f.t)
+}
+
+/// dp/du and dp/dv of the sphere's (u, v) = (phi / 2 pi, theta / pi) at the unit direction
+/// `local` from its centre (Mitsuba's, including its choice at the poles).
+fn sphere_dpduv(local: Vec3, radius: f32) -> (Vec3, Vec3) {
+    use std::f32::consts::PI;
+    let dpdu = Vec3 { x: -local.y, y: local.x, z: 0.0 } * (2.0 * PI * radius);
+    let rd = (local.x * local.x + local.y * local.y).sqrt();
+    let dpdv = if rd > 0.0 {
+        Vec3 { x: local.z * local.x / rd, y: local.z * local.y / rd, z: -rd }
+    } else {
+        Vec3 { x: 1.0, y: 0.0, z: 0.0 }
+    };
+    (dpdu, dpdv * (PI * radius))
 }

@@ -10,7 +10,7 @@
 //! A new BSDF is tested by adding one `BsdfCase` to the list in `tests/bsdf_sampling.rs`.
 
 use super::stats::{chi2_survival, Estimate};
-use glint::bsdf::Bsdf;
+use glint::bsdf::ShadedBsdf;
 use glint::math::Vec3;
 use glint::sampling::Rng;
 
@@ -22,7 +22,8 @@ const MIN_EXPECTED: f64 = 5.0;
 #[derive(Clone, Debug)]
 pub struct BsdfCase {
     pub name: String,
-    pub bsdf: Bsdf,
+    /// A BSDF, possibly in a tilted frame (normal and bump maps).
+    pub bsdf: ShadedBsdf,
     pub wo: Vec3,
     /// Sampling never fails: every sample is valid or delta, so ∫ pdf = 1 - P(delta).
     pub complete: bool,

@@ -6,6 +6,7 @@
 
 mod props;
 mod spectrum;
+mod surface;
 pub mod xml;
 
 use super::Define;
@@ -271,6 +272,11 @@ impl<'a> Reader<'a> {
 
     fn texture(&self, p: &Props<'a>, name: &str, default: Rgb) -> Result<TextureDesc, Error> {
         let Some(e) = p.find(name) else { return Ok(TextureDesc::constant(default)) };
+        self.texture_element(e)
+    }
+
+    /// The texture (or colour) an element gives.
+    fn texture_element(&self, e: &'a Element) -> Result<TextureDesc, Error> {
         let e = self.resolve(e)?;
         if e.tag != "texture" {
             return Ok(TextureDesc::constant(color_of(e, SpectrumUse::Reflectance)?));
@@ -297,7 +303,10 @@ impl<'a> Reader<'a> {
                 uv_scale,
                 uv_offset,
             }),
-            other => Err(e.err(format!("texture plugin '{other}' is not supported (bitmap, checkerboard)"))),
+            "mesh_attribute" => self.mesh_attribute(e, &tp),
+            other => {
+                Err(e.err(format!("texture plugin '{other}' is not supported (bitmap, checkerboard, mesh_attribute)")))
+            }
         }
     }
 
@@ -374,6 +383,7 @@ impl<'a> Reader<'a> {
                 let (m, _) = self.material_model(inner)?;
                 return Ok((m, true));
             }
+            "normalmap" | "bumpmap" | "mask" => return self.surface_material(el, ty),
             "diffuse" => MaterialModel::Diffuse { reflectance: self.texture(&p, "reflectance", Rgb::splat(0.5))? },
             "conductor" | "roughconductor" => {
                 let roughness = if ty == "roughconductor" { Some(self.roughness(&p)?) } else { None };
@@ -430,7 +440,13 @@ impl<'a> Reader<'a> {
             };
             self.note(result);
         }
-        let material = material.map_or(MaterialRef::DefaultDiffuse, MaterialRef::Index);
+        // Mitsuba gives a shape without a BSDF a diffuse 0.5 one, and an emitting shape a
+        // black one (its light does not reflect light).
+        let material = match (material, &emission) {
+            (Some(m), _) => MaterialRef::Index(m),
+            (None, Some(_)) => MaterialRef::Black,
+            (None, None) => MaterialRef::DefaultDiffuse,
+        };
         let geometry = match ty {
             "obj" | "ply" => {
                 let file = p.string("filename").ok_or_else(|| el.err(format!("shape '{ty}' needs 'filename'")))?;

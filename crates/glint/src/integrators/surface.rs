@@ -1,0 +1,115 @@
+//! What a surface does before its BSDF scatters: normal and bump maps tilt the shading
+//! frame, masks let light through. Shared by the integrators.
+
+use super::Counters;
+use crate::bsdf::{flip_invalid, normal_map_frame, ShadedBsdf};
+use crate::materials::{Perturbation, TexturePoint};
+use crate::math::{offset_origin, Frame, Ray, Vec3};
+use crate::world::{ShapeRef, SurfaceInteraction, World};
+
+/// The most masked surfaces one ray passes through; a ray that meets more (a stack of
+/// coincident cut-outs) stops at the next one, as if it were opaque.
+pub(crate) const MAX_MASK_PASSES: u32 = 256;
+
+/// Where textures are looked up for `si`.
+pub(crate) fn texture_point<'a>(scene: &'a World, si: &SurfaceInteraction) -> TexturePoint<'a> {
+    let mesh = scene.instances.get(si.instance as usize).and_then(|inst| match inst.shape {
+        ShapeRef::Mesh(m) => scene.meshes.get(m as usize).map(|m| &**m),
+        ShapeRef::Sphere(_) => None,
+    });
+    TexturePoint { uv: si.uv, prim: si.prim, bary: si.bary, mesh }
+}
+
+/// The probability that light meeting the surface at `si` scatters there (1 unless masked).
+pub(crate) fn opacity(scene: &World, si: &SurfaceInteraction) -> f32 {
+    let mat = &scene.materials[si.material as usize];
+    if !mat.is_masked() {
+        return 1.0;
+    }
+    mat.opacity(&texture_point(scene, si))
+}
+
+/// The fraction of light that gets along a shadow ray: 1 when nothing blocks it, 0 when an
+/// opaque surface does, the product of (1 − opacity) over the masked surfaces it crosses
+/// otherwise (the expected value of passing each one, as Mitsuba's volumetric path tracer
+/// counts null surfaces; its `path` integrator stops shadow rays at every surface).
+pub(crate) fn transmittance(scene: &World, ray: &Ray, c: &mut Counters) -> f32 {
+    if !scene.occluded(ray) {
+        return 1.0;
+    }
+    if !scene.has_masks {
+        return 0.0;
+    }
+    let mut r = *ray;
+    let mut t = 1.0f32;
+    for _ in 0..MAX_MASK_PASSES {
+        let Some(hit) = scene.intersect(&r) else { return t };
+        let si = scene.interaction(&r, &hit);
+        t *= 1.0 - opacity(scene, &si);
+        if !(t > 0.0) {
+            return 0.0;
+        }
+        c.shadow_rays += 1;
+        // Carry on from just past the surface, to the same end point (or to infinity).
+        let o = offset_origin(si.p, si.ng, r.dir);
+        let t_max = if r.t_max.is_finite() {
+            let along = (r.at(r.t_max) - o).dot(r.dir) / r.dir.length_squared();
+            if !(along > 0.0) {
+                return t;
+            }
+            along
+        } else {
+            f32::INFINITY
+        };
+        r = Ray { origin: o, dir: r.dir, t_min: 0.0, t_max };
+    }
+    0.0
+}
+
+/// The BSDF at a hit and the frame to evaluate it in (see [`super::shading`]): the frame
+/// faces the viewer for two-sided materials, and a normal or bump map tilts the BSDF
+/// within it.
+pub(crate) fn shade(scene: &World, si: &SurfaceInteraction, wo_world: Vec3) -> (ShadedBsdf, Frame) {
+    let mat = &scene.materials[si.material as usize];
+    let p = texture_point(scene, si);
+    let bsdf = mat.bsdf_at(&p);
+    let mut frame = si.frame;
+    if mat.two_sided && !mat.is_transmissive() && frame.n.dot(wo_world) < 0.0 {
+        // Mirrored in the tangent plane, as Mitsuba's `twosided` mirrors directions.
+        frame = Frame { s: frame.s, t: frame.t, n: -frame.n };
+    }
+    let Some(perturbation) = mat.perturbation() else { return (bsdf.into(), frame) };
+    let wo = frame.to_local(wo_world);
+    let tilt = match perturbation {
+        Perturbation::NormalMap { normals } => {
+            let c = normals.eval_at(&p);
+            normal_map_frame(Vec3 { x: 2.0 * c.r - 1.0, y: 2.0 * c.g - 1.0, z: 2.0 * c.b - 1.0 }, wo)
+        }
+        Perturbation::BumpMap { height, scale } => bump_frame(si, height.luminance_gradient(si.uv), scale, wo),
+    };
+    (ShadedBsdf { bsdf, tilt }, frame)
+}
+
+/// Mitsuba's bump-mapped frame, in the surface's shading frame: dp/du and dp/dv moved along
+/// the shading normal by the height's gradient, their cross product turned to the side of
+/// the geometric normal. Computed on the unmirrored surface (the mirror of a two-sided
+/// material applies to it as to directions).
+fn bump_frame(si: &SurfaceInteraction, grad: [f32; 2], scale: f32, wo: Vec3) -> Option<Frame> {
+    let n = si.frame.n;
+    let dpdu = si.dpdu + n * (scale * grad[0] - n.dot(si.dpdu));
+    let dpdv = si.dpdv + n * (scale * grad[1] - n.dot(si.dpdv));
+    let mut nb = dpdu.cross(dpdv).normalize();
+    if !nb.is_finite() {
+        return None;
+    }
+    if si.ng.dot(nb) < 0.0 {
+        nb = -nb;
+    }
+    let local = flip_invalid(si.frame.to_local(nb), wo);
+    let len = local.length();
+    if !(len > 0.0) || !len.is_finite() {
+        return None;
+    }
+    let local = local / len;
+    Some(Frame::from_normal_tangent(local, si.frame.to_local(si.dpdu)))
+}
