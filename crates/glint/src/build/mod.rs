@@ -6,6 +6,7 @@
 
 mod builder;
 mod cache;
+mod media;
 mod validate;
 
 pub use builder::{LoadedGroup, WorldBuilder};
@@ -113,6 +114,7 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
             Material::plastic(textures.texture(diffuse)?, *specular, *eta, roughness.as_ref().map(microfacet))
         }
         MaterialModel::Black => MaterialKind::Black,
+        MaterialModel::Null => MaterialKind::Null,
     })
 }
 

@@ -6,9 +6,10 @@
 mod direct;
 mod first_hit;
 mod path;
+mod volpath;
 mod whitted;
 
-pub use crate::describe::{DirectSettings, PathSettings, Strategy, WhittedSettings};
+pub use crate::describe::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 
 use crate::bsdf::Bsdf;
@@ -28,6 +29,7 @@ pub enum Integrator {
     Whitted(WhittedSettings),
     Path(PathSettings),
     Direct(DirectSettings),
+    Volpath(VolpathSettings),
 }
 
 impl From<&crate::describe::IntegratorDesc> for Integrator {
@@ -36,6 +38,7 @@ impl From<&crate::describe::IntegratorDesc> for Integrator {
             crate::describe::IntegratorDesc::Whitted(w) => Integrator::Whitted(w.clone()),
             crate::describe::IntegratorDesc::Path(p) => Integrator::Path(p.clone()),
             crate::describe::IntegratorDesc::Direct(s) => Integrator::Direct(s.clone()),
+            crate::describe::IntegratorDesc::Volpath(s) => Integrator::Volpath(s.clone()),
         }
     }
 }
@@ -46,6 +49,7 @@ impl Integrator {
             Integrator::Whitted(_) => "whitted",
             Integrator::Path(_) => "path",
             Integrator::Direct(_) => "direct",
+            Integrator::Volpath(_) => "volpath",
         }
     }
 
@@ -55,6 +59,7 @@ impl Integrator {
             Integrator::Whitted(s) => whitted::li(s, scene, ray, rng, counters),
             Integrator::Path(s) => path::li(s, scene, ray, rng, counters),
             Integrator::Direct(s) => direct::li(s, scene, ray, rng, counters),
+            Integrator::Volpath(s) => volpath::li(s, scene, ray, rng, counters),
         }
     }
 }

@@ -51,6 +51,8 @@ pub enum MaterialKind {
         params: PlasticParams,
     },
     Black,
+    /// Lets light through unchanged: a medium's boundary.
+    Null,
 }
 
 #[derive(Clone, Debug)]
@@ -78,6 +80,7 @@ impl Material {
             MaterialKind::Dielectric { .. }
                 | MaterialKind::RoughDielectric { .. }
                 | MaterialKind::ThinDielectric { .. }
+                | MaterialKind::Null
         )
     }
 
@@ -93,6 +96,7 @@ impl Material {
             | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
             MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
             MaterialKind::Black => Rgb::BLACK,
+            MaterialKind::Null => Rgb::WHITE,
         }
     }
 
@@ -120,6 +124,7 @@ impl Material {
                 Bsdf::Plastic(PlasticParams { diffuse: diffuse.eval(uv), ..*params })
             }
             MaterialKind::Black => Bsdf::Black,
+            MaterialKind::Null => Bsdf::Null,
         }
     }
 }

@@ -125,7 +125,7 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
             out.push(("eta", Slot::Float(eta)));
             roughness_slots(roughness, &mut out);
         }
-        MaterialModel::Black => {}
+        MaterialModel::Black | MaterialModel::Null => {}
     }
     out
 }
