@@ -1,8 +1,11 @@
 //! Volumetric path tracing (Mitsuba's `volpath`): the path tracer of `path`, with media.
 //!
-//! A ray travelling in a medium either scatters before the next surface (the free-flight
-//! distance is sampled by [`sample_distance`], unbiased per channel for RGB extinction) or
-//! reaches it. At a scattering point the light is sampled (next-event estimation, with the
+//! A ray travelling in a medium either scatters before the next surface or reaches it. The
+//! free-flight distances of a path are drawn from one colour channel's exponential (the hero
+//! channel, chosen per path), and the path is weighted by its contribution over the mean of
+//! the three channels' path densities: spectral MIS with the balance heuristic over whole
+//! paths (as Mitsuba's `volpathmis`), unbiased in every channel and at most 3 times the
+//! channel's own estimate, where following one channel (Mitsuba's `volpath`) has no bound. At a scattering point the light is sampled (next-event estimation, with the
 //! transmittance along the shadow ray) and the phase function continues the path, the two
 //! combined by MIS as at surfaces. Surfaces with a `null` BSDF (and the straight-through
 //! lobe of a thin dielectric) are passages, not scattering events: paths go on through them
@@ -52,6 +55,10 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
     let mut prev_p = ray.origin;
     let mut depth = 0u32; // scattering events so far
     let mut passages = 0u32;
+    // The hero channel, and each channel's path density over their mean (`throughput` is the
+    // path contribution over that mean).
+    let channel = if scene.media.is_empty() { 0 } else { ((rng.next_f32() * 3.0) as usize).min(2) };
+    let mut density_ratio = Rgb::WHITE;
 
     loop {
         c.rays += 1;
@@ -60,12 +67,17 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
         if let Some(mi) = medium {
             let m = &scene.media[mi as usize];
             let t_max = hit.map_or(f32::INFINITY, |h| h.t);
-            let (scatter, weight) = sample_distance(m, t_max, rng.next_f32(), rng.next_f32());
-            throughput *= weight;
+            let flight = sample_distance(m, t_max, channel, rng.next_f32());
+            let mean = (density_ratio * flight.density).average();
+            if !(mean > 0.0) {
+                break;
+            }
+            throughput = throughput * flight.value / mean;
+            density_ratio = density_ratio * flight.density / mean;
             if throughput.is_black() {
                 break;
             }
-            if let Some(t) = scatter {
+            if let Some(t) = flight.t {
                 depth += 1;
                 if depth >= max_depth {
                     break;

@@ -71,32 +71,30 @@ impl MediumBoundary {
     }
 }
 
-/// Samples a free-flight distance in a medium with extinction `sigma_t`, unbiased in every
-/// channel: one channel is chosen uniformly and the distance drawn from its exponential,
-/// and the estimate is weighted by the mean of the three channels' densities (the balance
-/// heuristic over channels, "spectral MIS"), so no channel needs its own path.
-///
-/// `u_channel` and `u` are uniform in [0, 1); `t_max` is the distance to the next surface.
-/// Returns the distance (`None`: the surface is reached first) and the weight to multiply
-/// the throughput by: at a scattering point `transmittance * sigma_s / density`, else
-/// `transmittance / probability`.
-pub fn sample_distance(m: &Medium, t_max: f32, u_channel: f32, u: f32) -> (Option<f32>, Rgb) {
-    let channel = ((u_channel * 3.0) as usize).min(2);
-    let sigma = m.sigma_t.channel(channel);
+/// One free-flight sample: where the ray scatters (`None`: it reaches the surface first),
+/// the path contribution of the segment per channel (`transmittance * sigma_s` at a
+/// scattering point, `transmittance` when the surface is reached), and the density with
+/// which each channel's own exponential would have produced that outcome (`sigma_t *
+/// transmittance`, or the probability `transmittance` of getting past `t_max`).
+#[derive(Clone, Copy, Debug)]
+pub struct FreeFlight {
+    pub t: Option<f32>,
+    pub value: Rgb,
+    pub density: Rgb,
+}
+
+/// Samples a free-flight distance from channel `channel`'s exponential (`u` uniform in
+/// [0, 1); `t_max` the distance to the next surface). The volumetric path tracer weights the
+/// path by the mean of the channels' path densities (spectral MIS), so that the estimate is
+/// unbiased in every channel whichever channel drew the distances.
+pub fn sample_distance(m: &Medium, t_max: f32, channel: usize, u: f32) -> FreeFlight {
+    let sigma = m.sigma_t.channel(channel.min(2));
     let t = if sigma > 0.0 { -(1.0 - u).ln() / sigma } else { f32::INFINITY };
     if t < t_max {
         let tr = m.transmittance(t);
-        let density = (m.sigma_t * tr).average();
-        if !(density > 0.0) {
-            return (None, Rgb::BLACK);
-        }
-        (Some(t), tr * m.sigma_s / density)
+        FreeFlight { t: Some(t), value: tr * m.sigma_s, density: m.sigma_t * tr }
     } else {
         let tr = m.transmittance(t_max);
-        let probability = tr.average();
-        if !(probability > 0.0) {
-            return (None, Rgb::BLACK);
-        }
-        (None, tr / probability)
+        FreeFlight { t: None, value: tr, density: tr }
     }
 }

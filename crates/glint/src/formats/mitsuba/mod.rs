@@ -421,6 +421,8 @@ impl<'a> Reader<'a> {
                 let roughness = if ty == "roughplastic" { Some(self.roughness(&p)?) } else { None };
                 MaterialModel::Plastic { diffuse, specular, eta, roughness }
             }
+            // Passes light through unchanged: the boundary of a medium (see the volpath integrator).
+            "null" => MaterialModel::Null,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
