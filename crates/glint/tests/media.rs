@@ -98,8 +98,11 @@ fn shadow_rays_through_an_absorbing_slab_carry_exp_minus_sigma_t_d() {
     let exact = SIGMA.map(|s| (-s).exp() as f32);
     for p in &out.image.pixels {
         for c in 0..3 {
+            // Each of the two crossings moves the ray off the surface by 1e-4 (1 + |p|max),
+            // |p|max ≤ 3 here: the medium path is up to 8e-4 short, so T is up to σ 8e-4 high.
+            let tolerance = SIGMA[c] as f32 * 1e-3 + 1e-5;
             let rel = (p.channel(c) - exact[c]).abs() / exact[c];
-            assert!(rel < 1e-4, "channel {c}: {} instead of {}", p.channel(c), exact[c]);
+            assert!(rel < tolerance, "channel {c}: {} instead of {}", p.channel(c), exact[c]);
         }
     }
 }

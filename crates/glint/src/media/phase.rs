@@ -57,8 +57,10 @@ impl Phase {
     }
 }
 
-/// The Henyey-Greenstein density at cos θ from the travel direction.
+/// The Henyey-Greenstein density at cos θ from the travel direction (in f64: near |g| = 1
+/// the denominator cancels to (1 - |g|)² at the peak).
 fn hg(g: f32, cos_t: f32) -> f32 {
-    let denom = 1.0 + g * g - 2.0 * g * cos_t;
-    (1.0 - g * g) / (4.0 * PI * denom * denom.max(0.0).sqrt())
+    let (g, c) = (g as f64, cos_t as f64);
+    let denom = (1.0 + g * g - 2.0 * g * c).max(0.0);
+    ((1.0 - g * g) / (4.0 * std::f64::consts::PI * denom * denom.sqrt())) as f32
 }
