@@ -57,7 +57,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub spp: Option<u32>,
     /// Integrator (default: the scene's).
-    #[arg(long, value_parser = ["whitted", "path", "direct"])]
+    #[arg(long, value_parser = ["whitted", "path", "direct", "volpath"])]
     pub integrator: Option<String>,
     /// Longest path (path: segments, -1 unbounded; whitted: recursion depth).
     #[arg(long, allow_hyphen_values = true)]

@@ -325,6 +325,9 @@ fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
         Some("direct") if !matches!(d.integrator, IntegratorDesc::Direct(_)) => {
             d.integrator = IntegratorDesc::Direct(DirectSettings::default())
         }
+        Some("volpath") if !matches!(d.integrator, IntegratorDesc::Volpath(_)) => {
+            d.integrator = IntegratorDesc::Volpath(glint::describe::VolpathSettings::default())
+        }
         _ => {}
     }
     match &mut d.integrator {
@@ -363,6 +366,21 @@ fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
             }
             if let Some(s) = a.strategy {
                 p.strategy = s;
+            }
+        }
+        IntegratorDesc::Volpath(v) => {
+            if let Some(depth) = a.max_depth {
+                if depth >= u32::MAX as i64 {
+                    return Err(format!(
+                        "--max-depth {depth} is out of range (-1 for unbounded, or 0 to {})",
+                        u32::MAX - 1
+                    )
+                    .into());
+                }
+                v.max_depth = if depth < 0 { None } else { Some(depth as u32) };
+            }
+            if a.strategy.is_some() {
+                return Err("--strategy applies to the path integrator only".into());
             }
         }
     }

@@ -11,7 +11,7 @@
 //!   command line, Python) uses.
 //!
 //! Below them: [`math`], [`sampling`], [`accel`] (BVHs over boxes and triangles),
-//! [`geometry`] (shapes), [`bsdf`] and [`materials`], [`lights`], [`camera`], [`io`] (images
+//! [`geometry`] (shapes), [`bsdf`] and [`materials`], [`media`] (participating media), [`lights`], [`camera`], [`io`] (images
 //! and meshes) and [`error`] (one error type with a source location).
 
 pub mod accel;
@@ -27,6 +27,7 @@ pub mod io;
 pub mod lights;
 pub mod materials;
 pub mod math;
+pub mod media;
 pub mod render;
 pub mod sampling;
 pub mod session;

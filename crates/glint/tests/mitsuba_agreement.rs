@@ -184,3 +184,41 @@ fn opacity_masks() {
 fn mesh_attributes() {
     check("mesh-attribute");
 }
+
+/// As `check`, for scenes with participating media: channel means within 2%.
+fn check_media(name: &str) {
+    let entry = reference_entry(name);
+    let mitsuba_rel_mse = entry["mitsuba_rel_mse"].as_f64().unwrap();
+    let image = render_at(name, entry["test_spp"].as_u64().unwrap());
+    let reference = read_image(&dir().join(format!("references/{name}.exr"))).unwrap();
+    assert_eq!((image.width, image.height), (reference.width, reference.height));
+    let (ours, theirs) = (image.channel_means(), reference.channel_means());
+    let err = rel_mse(&image, &reference);
+    eprintln!("{name}: means {ours:?} vs {theirs:?}; relMSE {err:.3e} vs Mitsuba's {mitsuba_rel_mse:.3e}");
+    for k in 0..3 {
+        let rel = (ours[k] - theirs[k]).abs() / theirs[k].max(1e-6);
+        assert!(
+            rel < 0.02,
+            "{name}: channel {k} mean {} differs from Mitsuba's {} by {:.2}%",
+            ours[k],
+            theirs[k],
+            rel * 100.0
+        );
+    }
+    assert!(err <= 1.3 * mitsuba_rel_mse, "{name}: relative MSE {err:.3e} > 1.3 x Mitsuba's {mitsuba_rel_mse:.3e}");
+}
+
+#[test]
+fn volpath_fog_in_a_null_sphere() {
+    check_media("medium-fog");
+}
+
+#[test]
+fn volpath_scattering_medium_in_glass() {
+    check_media("medium-glass");
+}
+
+#[test]
+fn volpath_camera_in_fog_with_rgb_extinction() {
+    check_media("medium-rgb");
+}

@@ -425,7 +425,7 @@ fn serialized_robustness() {
 }
 
 /// A scene with several unsupported features reports every one, a line each with file and
-/// line, then fails; media anywhere are errors (not ignored parameters).
+/// line, then fails; unsupported media features among them (not ignored parameters).
 #[test]
 fn every_unsupported_feature_is_reported() {
     let dir = scratch("many");
@@ -438,11 +438,11 @@ fn every_unsupported_feature_is_reported() {
 <shape type="cylinder"/>
 <shape type="sphere">
   <bsdf type="velvet"/>
-  <medium type="homogeneous" name="interior"/>
+  <medium type="heterogeneous" name="interior"/>
 </shape>
 <emitter type="projector"/>
-<medium type="homogeneous" id="fog"/>
-<shape type="sphere"><ref name="exterior" id="fog"/></shape>
+<phase type="hg" id="p"/>
+<shape type="sphere"><medium type="homogeneous" name="inside"/></shape>
 <shape type="hair"><bsdf type="velvet"/></shape>
 <bsdf type="blendbsdf" id="b"/>
 <shape type="sphere"><ref id="b"/></shape>
@@ -455,10 +455,10 @@ fn every_unsupported_feature_is_reported() {
     let expect = [
         (4, "cylinder"),
         (6, "velvet"),
-        (7, "medium"),
+        (7, "heterogeneous"),
         (9, "projector"),
-        (10, "participating media"),
-        (11, "medium"),
+        (10, "phase"),
+        (11, "'interior' or 'exterior'"),
         (12, "velvet"),
         (12, "hair"),
         (13, "blendbsdf"),

@@ -74,6 +74,8 @@ pub enum Bsdf {
     Plastic(crate::bsdf::PlasticParams),
     /// Absorbs everything (light sources with no material).
     Black,
+    /// Passes light straight through, unchanged (Mitsuba's `null`): a medium's boundary.
+    Null,
 }
 
 mod plastic;
@@ -83,7 +85,7 @@ impl Bsdf {
     /// True when every lobe is a delta: light sampling is pointless there.
     pub fn is_delta(&self) -> bool {
         match self {
-            Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => true,
+            Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::Null => true,
             Bsdf::Plastic(p) => p.is_delta_only(),
             _ => false,
         }
@@ -123,7 +125,11 @@ impl Bsdf {
                 microfacet::eval_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.eval(wo, wi),
-            Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::Black => Rgb::BLACK,
+            Bsdf::Conductor { .. }
+            | Bsdf::Dielectric { .. }
+            | Bsdf::ThinDielectric { .. }
+            | Bsdf::Black
+            | Bsdf::Null => Rgb::BLACK,
         }
     }
 
@@ -220,6 +226,7 @@ impl Bsdf {
             }
             Bsdf::Plastic(p) => p.sample(wo, u_lobe, u),
             Bsdf::Black => None,
+            Bsdf::Null => Some(BsdfSample { wi: -wo, weight: Rgb::WHITE, pdf: 1.0, delta: true, eta: 1.0 }),
         }
     }
 

@@ -11,6 +11,7 @@ use crate::lights::LightSelection;
 use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
 use crate::math::{Aabb, Rgb, Transform, Vec3};
+use crate::media::{Medium, MediumBoundary};
 use crate::world::{Instance, ShapeRef, World};
 use std::collections::HashMap;
 use std::path::Path;
@@ -120,6 +121,8 @@ pub struct WorldBuilder {
     lights: Vec<PendingLight>,
     mesh_ids: HashMap<*const TriangleMesh, u32>,
     pub build_seconds: f64,
+    media: Vec<Medium>,
+    camera_medium: Option<u32>,
 }
 
 impl WorldBuilder {
@@ -134,6 +137,8 @@ impl WorldBuilder {
             lights: Vec::new(),
             mesh_ids: HashMap::new(),
             build_seconds: 0.0,
+            media: Vec::new(),
+            camera_medium: None,
         }
     }
 
@@ -250,6 +255,7 @@ impl WorldBuilder {
             light,
             flip_normals,
             bounds,
+            media: MediumBoundary::default(),
         });
         Ok(())
     }
@@ -293,6 +299,7 @@ impl WorldBuilder {
             light,
             flip_normals,
             bounds: sphere.bounds(),
+            media: MediumBoundary::default(),
         });
         Ok(())
     }
@@ -308,6 +315,24 @@ impl WorldBuilder {
     }
     pub fn add_envmap(&mut self, image: Bitmap, scale: f32, to_world: Transform) {
         self.lights.push(PendingLight::EnvMap { image, scale, to_world });
+    }
+
+    /// Adds a medium; its index is what [`MediumBoundary`] and the camera refer to.
+    pub fn add_medium(&mut self, m: Medium) -> u32 {
+        self.media.push(m);
+        self.media.len() as u32 - 1
+    }
+
+    /// Puts the camera in a medium (by index).
+    pub fn set_camera_medium(&mut self, medium: Option<u32>) {
+        self.camera_medium = medium;
+    }
+
+    /// Makes the instances placed since `first` (one shape's) bound the given media.
+    pub fn set_media_since(&mut self, first: usize, media: MediumBoundary) {
+        for inst in &mut self.instances[first..] {
+            inst.media = media;
+        }
     }
 
     pub fn light_count(&self) -> usize {
@@ -343,6 +368,8 @@ impl WorldBuilder {
             bvh_split: self.split,
             bvh_build_seconds: 0.0,
             has_masks: false,
+            media: self.media,
+            camera_medium: self.camera_medium,
         };
         scene.finish(selection);
         scene.bvh_build_seconds = self.build_seconds + start.elapsed().as_secs_f64();

@@ -121,12 +121,17 @@ pub fn build_cached(
         material_ids.push(b.add_material(Material::new(m.name.clone(), kind, m.two_sided)));
     }
     load_files(desc, opts.bvh_split, cache, &mut b)?;
+    for m in super::media::media(desc) {
+        b.add_medium(m);
+    }
+    b.set_camera_medium(desc.camera.medium.map(|i| i as u32));
 
     let mut layout = WorldLayout { materials: desc.materials.len() as u32, ..WorldLayout::default() };
     for (index, s) in desc.shapes.iter().enumerate() {
         let first = b.instance_count() as u32;
         let place = Placement { index, instanced: instanced.contains(&index) };
         add_shape(&mut b, desc, s, &place, &material_ids, cache, &mut used).map_err(|e| e.or_at(&s.loc))?;
+        b.set_media_since(first as usize, super::media::boundary(&s.media));
         layout.shape_instances.push(first..b.instance_count() as u32);
     }
     layout.shape_lights = b.light_count() as u32;
@@ -361,6 +366,13 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
     world.lights.extend(lights);
     world.environment_lights = environment_lights(&world.lights);
     world.camera = camera;
+    world.media = super::media::media(desc);
+    world.camera_medium = desc.camera.medium.map(|i| i as u32);
+    for (s, instances) in desc.shapes.iter().zip(&layout.shape_instances) {
+        for i in instances.clone() {
+            world.instances[i as usize].media = super::media::boundary(&s.media);
+        }
+    }
     // Light powers changed: the light-selection distribution follows them.
     world.set_light_selection(desc.light_selection);
     Ok(true)

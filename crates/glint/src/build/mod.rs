@@ -6,6 +6,7 @@
 
 mod builder;
 mod cache;
+mod media;
 mod validate;
 
 pub use builder::{LoadedGroup, WorldBuilder};
@@ -129,6 +130,7 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
             opacity: textures.texture(opacity)?,
             nested: Box::new(material_kind(nested, textures)?),
         },
+        MaterialModel::Null => MaterialKind::Null,
     })
 }
 

@@ -51,7 +51,9 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
                 }
             }
         }
+        IntegratorDesc::Volpath(_) => {}
     }
+    super::media::check(d)?;
     let mut names = std::collections::HashSet::new();
     for m in &d.materials {
         if !names.insert(m.name.as_str()) {
@@ -186,7 +188,7 @@ fn material(m: &MaterialModel) -> Result<(), String> {
             color(*specular, "specular reflectance")?;
             alpha(roughness)?;
         }
-        MaterialModel::Diffuse { .. } | MaterialModel::Black => {}
+        MaterialModel::Diffuse { .. } | MaterialModel::Black | MaterialModel::Null => {}
         MaterialModel::BumpMap { scale, nested, .. } => {
             if !scale.is_finite() {
                 return Err(format!("bump map scale {scale} must be finite"));

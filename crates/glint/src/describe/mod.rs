@@ -19,7 +19,9 @@ use std::path::{Path, PathBuf};
 
 mod integrator;
 pub mod limits;
+mod medium;
 pub use integrator::{DirectSettings, PathSettings, Strategy, WhittedSettings};
+pub use medium::{MediumDesc, PhaseDesc, VolpathSettings};
 
 /// A 4x4 row-major object-to-world matrix (column vectors: `p' = M p`).
 pub type Matrix4 = [[f64; 4]; 4];
@@ -44,6 +46,9 @@ pub struct SceneDesc {
     pub lights: Vec<LightDesc>,
     /// What the reader accepted but cannot honour exactly (the CLI prints these).
     pub warnings: Vec<String>,
+    /// Participating media, referred to by index from shapes and the camera.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub media: Vec<MediumDesc>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -60,6 +65,9 @@ pub struct CameraDesc {
     /// `f32::MAX` for none (JSON has no infinity).
     pub far_clip: f32,
     pub loc: SourceLoc,
+    /// The medium the camera sits in (index into [`SceneDesc::media`]); `None` is vacuum.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub medium: Option<usize>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -76,6 +84,7 @@ pub enum IntegratorDesc {
     Whitted(WhittedSettings),
     Path(PathSettings),
     Direct(DirectSettings),
+    Volpath(VolpathSettings),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -156,6 +165,8 @@ pub enum MaterialModel {
         opacity: TextureDesc,
         nested: Box<MaterialModel>,
     },
+    /// Lets light through unchanged (Mitsuba's `null`): the boundary of a medium.
+    Null,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -224,6 +235,26 @@ pub struct ShapeDesc {
     pub emission: Option<Emission>,
     pub flip_normals: bool,
     pub loc: SourceLoc,
+    /// The media inside (behind the normal) and outside the shape, as indices into
+    /// [`SceneDesc::media`]; a shape with neither leaves the medium of a ray unchanged.
+    #[serde(default, skip_serializing_if = "ShapeMedia::is_none")]
+    pub media: ShapeMedia,
+}
+
+/// The media on the two sides of a shape (Mitsuba's `interior` and `exterior`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeMedia {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interior: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exterior: Option<usize>,
+}
+
+impl ShapeMedia {
+    pub fn is_none(&self) -> bool {
+        self.interior.is_none() && self.exterior.is_none()
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -327,6 +358,7 @@ impl SceneDesc {
             shapes: Vec::new(),
             lights: Vec::new(),
             warnings: Vec::new(),
+            media: Vec::new(),
         }
     }
 
@@ -417,7 +449,10 @@ impl MaterialModel {
             MaterialModel::Diffuse { reflectance } => vec![reflectance],
             MaterialModel::Phong { kd, .. } => vec![kd],
             MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
-            MaterialModel::Conductor { .. } | MaterialModel::Dielectric { .. } | MaterialModel::Black => vec![],
+            MaterialModel::Conductor { .. }
+            | MaterialModel::Dielectric { .. }
+            | MaterialModel::Black
+            | MaterialModel::Null => vec![],
             MaterialModel::NormalMap { normals: t, nested }
             | MaterialModel::BumpMap { height: t, nested, .. }
             | MaterialModel::Mask { opacity: t, nested } => {
@@ -433,7 +468,10 @@ impl MaterialModel {
             MaterialModel::Diffuse { reflectance } => vec![reflectance],
             MaterialModel::Phong { kd, .. } => vec![kd],
             MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
-            MaterialModel::Conductor { .. } | MaterialModel::Dielectric { .. } | MaterialModel::Black => vec![],
+            MaterialModel::Conductor { .. }
+            | MaterialModel::Dielectric { .. }
+            | MaterialModel::Black
+            | MaterialModel::Null => vec![],
             MaterialModel::NormalMap { normals: t, nested }
             | MaterialModel::BumpMap { height: t, nested, .. }
             | MaterialModel::Mask { opacity: t, nested } => {
@@ -467,6 +505,7 @@ impl Default for CameraDesc {
             near_clip: 0.0,
             far_clip: f32::MAX,
             loc: SourceLoc::default(),
+            medium: None,
         }
     }
 }
@@ -489,6 +528,7 @@ mod tests {
             emission: Some(Emission { radiance: Rgb::splat(2.0), two_sided: false }),
             flip_normals: false,
             loc: SourceLoc::new("a.json", 3, 5),
+            media: ShapeMedia::default(),
         });
         let text = serde_json::to_string(&d).unwrap();
         let back: SceneDesc = serde_json::from_str(&text).unwrap();
@@ -530,6 +570,7 @@ mod tests {
                 emission: None,
                 flip_normals: false,
                 loc: SourceLoc::default(),
+                media: ShapeMedia::default(),
             });
         }
         d.lights.push(LightDesc {

@@ -9,8 +9,8 @@ use crate::bsdf::MicrofacetKind;
 use crate::camera::FovAxis;
 use crate::describe::{
     CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
-    MaterialModel, MaterialRef, Matrix4, MeshFileDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc,
-    Strategy, TextureDesc, WhittedSettings,
+    MaterialModel, MaterialRef, Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc,
+    SceneDesc, ShapeDesc, ShapeMedia, Strategy, TextureDesc, VolpathSettings, WhittedSettings,
 };
 use crate::error::{Error, SourceLoc};
 use crate::lights::LightSelection;
@@ -38,6 +38,25 @@ struct JsonScene {
     shapes: Vec<JsonShape>,
     #[serde(default)]
     lights: Vec<JsonLight>,
+    #[serde(default)]
+    media: BTreeMap<String, JsonMedium>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JsonMedium {
+    #[serde(default, rename = "type")]
+    kind: Option<String>,
+    #[serde(default)]
+    sigma_t: Option<JsonColor>,
+    #[serde(default)]
+    albedo: Option<JsonColor>,
+    #[serde(default)]
+    scale: Option<f32>,
+    #[serde(default)]
+    phase: Option<PhaseDesc>,
+    #[serde(default)]
+    sample_emitters: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -54,6 +73,8 @@ struct JsonCamera {
     aperture_radius: f32,
     #[serde(default)]
     focus_distance: Option<f32>,
+    #[serde(default)]
+    medium: Option<String>,
 }
 
 fn default_up() -> [f32; 3] {
@@ -97,6 +118,16 @@ enum JsonIntegrator {
         emitter_samples: Option<u64>,
         #[serde(default)]
         bsdf_samples: Option<u64>,
+        #[serde(default)]
+        light_selection: Option<String>,
+        #[serde(default)]
+        hide_emitters: bool,
+    },
+    Volpath {
+        #[serde(default)]
+        max_depth: Option<i64>,
+        #[serde(default)]
+        rr_depth: Option<u64>,
         #[serde(default)]
         light_selection: Option<String>,
         #[serde(default)]
@@ -222,6 +253,8 @@ enum JsonMaterial {
     },
     /// `material` where opaque; light passes through with probability 1 - opacity.
     Mask { opacity: JsonTexture, material: Box<JsonMaterial> },
+    /// Lets light through unchanged: a medium's boundary.
+    Null {},
 }
 
 #[derive(Deserialize)]
@@ -257,6 +290,10 @@ struct JsonShape {
     flip_normals: bool,
     #[serde(default)]
     face_normals: bool,
+    #[serde(default)]
+    interior: Option<String>,
+    #[serde(default)]
+    exterior: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -494,6 +531,7 @@ fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(
             },
             true,
         ),
+        JsonMaterial::Null {} => (MaterialModel::Null, false),
         JsonMaterial::NormalMap { .. } | JsonMaterial::BumpMap { .. } | JsonMaterial::Mask { .. } => {
             return material_model_of(ctx, name, &at, m)
         }
@@ -542,6 +580,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         near_clip: 0.0,
         far_clip: f32::MAX,
         loc: ctx.loc("camera"),
+        medium: None,
     };
     let filter = match file.film.filter.as_deref() {
         None | Some("box") => PixelFilter::Box,
@@ -617,7 +656,40 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
                 hide_emitters: *hide_emitters,
             })
         }
+        Some(JsonIntegrator::Volpath { max_depth, rr_depth, light_selection, hide_emitters }) => {
+            if let Some(ls) = light_selection {
+                desc.light_selection =
+                    ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
+            }
+            IntegratorDesc::Volpath(VolpathSettings {
+                max_depth: match max_depth {
+                    Some(d) if *d < 0 => None,
+                    Some(d) => {
+                        Some(narrow(&ctx, "integrator/max_depth", "max_depth", *d as u64, 0, u32::MAX as u64 - 1)?)
+                    }
+                    None => None,
+                },
+                rr_depth: match rr_depth {
+                    Some(d) => narrow(&ctx, "integrator/rr_depth", "rr_depth", *d, 1, u32::MAX as u64 - 1)?,
+                    None => 5,
+                },
+                hide_emitters: *hide_emitters,
+            })
+        }
     };
+    for (name, m) in &file.media {
+        desc.media.push(medium_of(&ctx, name, m)?);
+    }
+    let medium_ref = |name: &Option<String>, at: &str| -> Result<Option<usize>, Error> {
+        match name {
+            None => Ok(None),
+            Some(n) => match file.media.keys().position(|k| k == n) {
+                Some(i) => Ok(Some(i)),
+                None => Err(ctx.err(at, format!("unknown medium '{n}'"))),
+            },
+        }
+    };
+    desc.camera.medium = medium_ref(&file.camera.medium, "camera/medium")?;
     desc.sampler = SamplerDesc {
         kind: match file.sampler.kind.as_deref() {
             None => SamplerKind::default(),
@@ -694,6 +766,10 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             emission,
             flip_normals: s.flip_normals,
             loc: ctx.loc(&at),
+            media: ShapeMedia {
+                interior: medium_ref(&s.interior, &format!("{at}/interior"))?,
+                exterior: medium_ref(&s.exterior, &format!("{at}/exterior"))?,
+            },
         });
     }
 
@@ -726,6 +802,22 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         desc.lights.push(LightDesc { light, loc: ctx.loc(&at) });
     }
     Ok(desc)
+}
+
+fn medium_of(ctx: &Ctx, name: &str, m: &JsonMedium) -> Result<MediumDesc, Error> {
+    let at = format!("media/{name}");
+    if let Some(k) = m.kind.as_deref().filter(|k| *k != "homogeneous") {
+        return Err(ctx.err(&format!("{at}/type"), format!("medium '{name}': unknown type '{k}' (homogeneous)")));
+    }
+    Ok(MediumDesc {
+        name: name.to_string(),
+        sigma_t: m.sigma_t.map_or(Rgb::WHITE, |c| c.rgb()),
+        albedo: m.albedo.map_or(Rgb::splat(0.75), |c| c.rgb()),
+        scale: m.scale.unwrap_or(1.0),
+        phase: m.phase.unwrap_or_default(),
+        sample_emitters: m.sample_emitters.unwrap_or(true),
+        loc: ctx.loc(&at),
+    })
 }
 
 /// serde_json appends " at line L column C"; the location is already at the front.

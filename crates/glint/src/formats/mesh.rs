@@ -35,6 +35,7 @@ pub fn describe(path: &Path) -> Result<SceneDesc, Error> {
         emission: None,
         flip_normals: false,
         loc: loc.clone(),
+        media: Default::default(),
     });
     d.lights.push(LightDesc { light: LightKind::Constant { radiance: Rgb::splat(0.4) }, loc: loc.clone() });
     d.lights.push(LightDesc {

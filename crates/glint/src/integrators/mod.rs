@@ -7,9 +7,10 @@ mod direct;
 mod first_hit;
 mod path;
 mod surface;
+mod volpath;
 mod whitted;
 
-pub use crate::describe::{DirectSettings, PathSettings, Strategy, WhittedSettings};
+pub use crate::describe::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 
 use crate::bsdf::ShadedBsdf;
@@ -29,6 +30,7 @@ pub enum Integrator {
     Whitted(WhittedSettings),
     Path(PathSettings),
     Direct(DirectSettings),
+    Volpath(VolpathSettings),
 }
 
 impl From<&crate::describe::IntegratorDesc> for Integrator {
@@ -37,6 +39,7 @@ impl From<&crate::describe::IntegratorDesc> for Integrator {
             crate::describe::IntegratorDesc::Whitted(w) => Integrator::Whitted(w.clone()),
             crate::describe::IntegratorDesc::Path(p) => Integrator::Path(p.clone()),
             crate::describe::IntegratorDesc::Direct(s) => Integrator::Direct(s.clone()),
+            crate::describe::IntegratorDesc::Volpath(s) => Integrator::Volpath(s.clone()),
         }
     }
 }
@@ -47,6 +50,7 @@ impl Integrator {
             Integrator::Whitted(_) => "whitted",
             Integrator::Path(_) => "path",
             Integrator::Direct(_) => "direct",
+            Integrator::Volpath(_) => "volpath",
         }
     }
 
@@ -56,6 +60,7 @@ impl Integrator {
             Integrator::Whitted(s) => whitted::li(s, scene, ray, rng, counters),
             Integrator::Path(s) => path::li(s, scene, ray, rng, counters),
             Integrator::Direct(s) => direct::li(s, scene, ray, rng, counters),
+            Integrator::Volpath(s) => volpath::li(s, scene, ray, rng, counters),
         }
     }
 }

@@ -73,6 +73,8 @@ pub enum MaterialKind {
         opacity: Texture,
         nested: Box<MaterialKind>,
     },
+    /// Lets light through unchanged: a medium's boundary.
+    Null,
 }
 
 #[derive(Clone, Debug)]
@@ -100,6 +102,7 @@ impl Material {
             MaterialKind::Dielectric { .. }
                 | MaterialKind::RoughDielectric { .. }
                 | MaterialKind::ThinDielectric { .. }
+                | MaterialKind::Null
         )
     }
 
@@ -114,6 +117,7 @@ impl Material {
             | MaterialKind::RoughDielectric { transmit, .. }
             | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
             MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
+            MaterialKind::Null => Rgb::WHITE,
             _ => Rgb::BLACK,
         }
     }
@@ -152,6 +156,7 @@ impl Material {
             | MaterialKind::NormalMap { .. }
             | MaterialKind::BumpMap { .. }
             | MaterialKind::Mask { .. } => Bsdf::Black,
+            MaterialKind::Null => Bsdf::Null,
         }
     }
 }

@@ -125,7 +125,7 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
             out.push(("eta", Slot::Float(eta)));
             roughness_slots(roughness, &mut out);
         }
-        MaterialModel::Black => {}
+        MaterialModel::Black | MaterialModel::Null => {}
         // The wrapped material's parameters, and a mask's constant opacity.
         MaterialModel::NormalMap { nested, .. } => return material_slots(nested),
         MaterialModel::BumpMap { scale, nested, .. } => {

@@ -13,6 +13,7 @@ use crate::geometry::{Sphere, TriangleMesh};
 use crate::lights::{Light, LightSelection};
 use crate::materials::Material;
 use crate::math::{Aabb, Frame, Ray, Transform, Vec3};
+use crate::media::{Medium, MediumBoundary};
 use crate::sampling::Distribution1d;
 use std::sync::Arc;
 
@@ -32,6 +33,8 @@ pub struct Instance {
     pub light: Option<u32>,
     pub flip_normals: bool,
     pub bounds: Aabb,
+    /// The media on the shape's two sides (none: rays keep their medium).
+    pub media: MediumBoundary,
 }
 
 /// What traversal returns: enough to find the hit again, nothing more.
@@ -87,6 +90,10 @@ pub struct World {
     pub(crate) bvh_build_seconds: f64,
     /// Some material has a mask (`mask`): shadow rays then look past what they hit.
     pub(crate) has_masks: bool,
+    /// Participating media, indexed by [`Instance::media`] and `camera_medium`.
+    pub(crate) media: Vec<Medium>,
+    /// The medium the camera sits in.
+    pub(crate) camera_medium: Option<u32>,
 }
 
 impl World {
@@ -348,6 +355,12 @@ impl World {
     }
     pub fn lights(&self) -> &[Light] {
         &self.lights
+    }
+    pub fn media(&self) -> &[Medium] {
+        &self.media
+    }
+    pub fn camera_medium(&self) -> Option<u32> {
+        self.camera_medium
     }
     pub fn top_level(&self) -> &TopLevelBvh {
         &self.top

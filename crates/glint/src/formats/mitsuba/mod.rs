@@ -4,6 +4,7 @@
 //! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
 //! an error that names the plugin, the file and the line.
 
+mod media;
 mod props;
 mod spectrum;
 mod surface;
@@ -14,7 +15,8 @@ use crate::bsdf::MicrofacetKind;
 use crate::camera::FovAxis;
 use crate::describe::{
     CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
-    MaterialRef, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, TextureDesc,
+    MaterialRef, MediumDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, ShapeMedia, TextureDesc,
+    VolpathSettings,
 };
 use crate::error::{Error, SourceLoc};
 use crate::materials::conductor_preset;
@@ -70,6 +72,9 @@ struct Reader<'a> {
     /// The scene's tree, for resolving file names through its search path.
     tree: &'a xml::SceneTree,
     source: xml::IncludeSource<'a>,
+    /// Media already described, by the element that defines them.
+    medium_index: HashMap<*const Element, usize>,
+    media: Vec<MediumDesc>,
 }
 
 pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
@@ -112,6 +117,8 @@ fn describe_tree<'a>(
         lights: Vec::new(),
         warnings: tree.warnings.clone(),
         errors: Vec::new(),
+        medium_index: HashMap::new(),
+        media: Vec::new(),
     };
     for c in &root.children {
         if let Some(id) = c.attr("id") {
@@ -140,8 +147,11 @@ fn describe_tree<'a>(
             }
             // Named BSDFs and textures are described when a shape refers to them, samplers
             // and films when the sensor does (an unreferenced one is ignored, as by Mitsuba).
-            "bsdf" | "texture" | "sampler" | "film" => Ok(()),
-            "medium" | "phase" | "volume" => Err(c.err(format!("<{}> (participating media) is not supported", c.tag))),
+            // Media too, when a shape or the sensor does.
+            "bsdf" | "texture" | "sampler" | "film" | "medium" => Ok(()),
+            "phase" | "volume" => {
+                Err(c.err(format!("<{}> at scene level is not supported (nest it in its <medium>)", c.tag)))
+            }
             other => Err(c.err(format!("unexpected element <{other}> in <scene>"))),
         };
         r.note(result);
@@ -160,6 +170,15 @@ fn describe_tree<'a>(
     desc.materials = r.materials;
     desc.shapes = r.shapes;
     desc.lights = r.lights;
+    if !desc.media.is_empty() || !r.media.is_empty() {
+        if !matches!(desc.integrator, IntegratorDesc::Volpath(_)) {
+            r.warnings.push(format!(
+                "{}: the scene has media, which only the volpath integrator renders (they are ignored, as Mitsuba's other integrators ignore them)",
+                path.display()
+            ));
+        }
+    }
+    desc.media = r.media;
     desc.warnings = r.warnings;
     Ok(desc)
 }
@@ -235,10 +254,15 @@ fn matrix(t: &Transform) -> crate::describe::Matrix4 {
 
 impl<'a> Reader<'a> {
     fn warn_unused(&mut self, p: &Props) {
-        for c in &p.el.children {
-            let medium = c.tag == "medium" || (c.tag == "ref" && self.resolve(c).is_ok_and(|t| t.tag == "medium"));
-            if medium {
-                self.note::<()>(Err(c.err("<medium> (participating media) is not supported")));
+        // Shapes and sensors read their media themselves.
+        if !matches!(p.el.tag.as_str(), "shape" | "sensor") {
+            for c in &p.el.children {
+                if self.is_medium(c) {
+                    self.note::<()>(Err(c.err(format!(
+                        "a <medium> inside a <{}> is not supported (media attach to shapes and sensors)",
+                        p.el.tag
+                    ))));
+                }
             }
         }
         for (name, line) in p.unused() {
@@ -407,6 +431,8 @@ impl<'a> Reader<'a> {
                 let roughness = if ty == "roughplastic" { Some(self.roughness(&p)?) } else { None };
                 MaterialModel::Plastic { diffuse, specular, eta, roughness }
             }
+            // Passes light through unchanged: the boundary of a medium (see the volpath integrator).
+            "null" => MaterialModel::Null,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
@@ -421,6 +447,7 @@ impl<'a> Reader<'a> {
         // BSDF: a nested <bsdf> or a <ref> to one.
         let mut material = None;
         let mut emission = None;
+        let mut media = ShapeMedia::default();
         // Each child's error is kept and the next child read, so that a shape with several
         // unsupported features reports them all.
         let errors_before = self.errors.len();
@@ -429,13 +456,13 @@ impl<'a> Reader<'a> {
                 "bsdf" => self.material(c).map(|m| material = Some(m)),
                 "ref" => self.resolve(c).and_then(|target| match target.tag.as_str() {
                     "bsdf" => self.material(target).map(|m| material = Some(m)),
-                    "medium" => Err(c.err("<medium> (participating media) is not supported")),
+                    "medium" => self.shape_medium(c, &mut media),
                     // A named area emitter at scene level, as Mitsuba allows.
                     "emitter" => self.area_emitter(target).map(|e| emission = Some(e)),
                     other => Err(c.err(format!("a shape cannot refer to a <{other}>"))),
                 }),
                 "emitter" => self.area_emitter(c).map(|e| emission = Some(e)),
-                "medium" => Err(c.err("<medium> (participating media) is not supported")),
+                "medium" => self.shape_medium(c, &mut media),
                 _ => Ok(()),
             };
             self.note(result);
@@ -491,6 +518,7 @@ impl<'a> Reader<'a> {
             emission,
             flip_normals,
             loc: el.loc(),
+            media,
         });
         Ok(())
     }
@@ -646,6 +674,7 @@ impl<'a> Reader<'a> {
             near_clip: p.float("near_clip", 1e-2)?,
             far_clip: p.float("far_clip", 1e4)?,
             loc: el.loc(),
+            medium: self.sensor_medium(el)?,
         };
         // Perspective cameras accept (and, like Mitsuba, ignore) a focus distance.
         let _ = p.opt_float("focus_distance")?;
@@ -690,6 +719,16 @@ impl<'a> Reader<'a> {
         };
         if ty == "direct" {
             return self.direct_integrator(el, &p);
+        }
+        // volpathmis is volpath with spectral MIS, which glint's volpath always uses.
+        if ty == "volpath" || ty == "volpathmis" {
+            let settings = VolpathSettings {
+                max_depth: depth(&p, -1)?,
+                rr_depth: rr_depth(&p)?,
+                hide_emitters: p.bool("hide_emitters", false)?,
+            };
+            self.warn_unused(&p);
+            return Ok(IntegratorDesc::Volpath(settings));
         }
         let settings = match ty {
             "path" => PathSettings {

@@ -126,7 +126,9 @@ impl<'a> Props<'a> {
             .children
             .iter()
             .filter_map(|c| c.attr("name").map(|n| (n, c)))
-            .filter(|(n, c)| !used.contains(*n) && !matches!(c.tag.as_str(), "bsdf" | "emitter" | "ref" | "rfilter"))
+            .filter(|(n, c)| {
+                !used.contains(*n) && !matches!(c.tag.as_str(), "bsdf" | "emitter" | "ref" | "rfilter" | "medium")
+            })
             .map(|(n, c)| (n.to_string(), c.line))
             .collect()
     }

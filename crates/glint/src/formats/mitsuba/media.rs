@@ -1,0 +1,167 @@
+//! Mitsuba's participating media: `<medium type="homogeneous">` with its `<phase>`
+//! (`isotropic`, `hg`), attached to shapes as `interior`/`exterior` (nested or by
+//! `<ref name=... id=...>`) and to the sensor. Heterogeneous media, grid volumes and other
+//! phase functions are errors that name the file and line.
+
+use super::props::{color_of, Props};
+use super::spectrum::SpectrumUse;
+use super::xml::Element;
+use super::Reader;
+use crate::describe::{MediumDesc, PhaseDesc, ShapeMedia};
+use crate::error::Error;
+use crate::math::Rgb;
+
+impl<'a> Reader<'a> {
+    /// Whether `el` is a `<medium>` or a `<ref>` to one.
+    pub(super) fn is_medium(&self, el: &'a Element) -> bool {
+        el.tag == "medium" || (el.tag == "ref" && self.resolve(el).is_ok_and(|t| t.tag == "medium"))
+    }
+
+    /// Describes (once) the medium `el` defines or refers to; its index in the media.
+    pub(super) fn medium(&mut self, el: &'a Element) -> Result<usize, Error> {
+        let el = self.resolve(el)?;
+        if let Some(&i) = self.medium_index.get(&(el as *const Element)) {
+            return Ok(i);
+        }
+        let desc = self.medium_desc(el)?;
+        let i = self.media.len();
+        self.media.push(desc);
+        self.medium_index.insert(el as *const Element, i);
+        Ok(i)
+    }
+
+    /// A shape's medium child `c` (nested or a `<ref>`), on the side its `name` says.
+    pub(super) fn shape_medium(&mut self, c: &'a Element, media: &mut ShapeMedia) -> Result<(), Error> {
+        let side = match c.attr("name") {
+            Some("interior") => &mut media.interior,
+            Some("exterior") => &mut media.exterior,
+            Some(other) => {
+                return Err(c.err(format!("a shape's medium is named 'interior' or 'exterior', not '{other}'")))
+            }
+            None => return Err(c.err("a shape's medium needs name=\"interior\" or name=\"exterior\"")),
+        };
+        if side.is_some() {
+            return Err(c.err(format!("the shape has two {} media", c.attr("name").unwrap_or(""))));
+        }
+        *side = Some(self.medium(c)?);
+        Ok(())
+    }
+
+    /// The sensor's medium (nested or a `<ref>`), if it names one; two are an error.
+    pub(super) fn sensor_medium(&mut self, sensor: &'a Element) -> Result<Option<usize>, Error> {
+        let mut found = None;
+        for c in &sensor.children {
+            if self.is_medium(c) {
+                if found.is_some() {
+                    return Err(c.err("only one medium can be given per sensor"));
+                }
+                found = Some(self.medium(c)?);
+            }
+        }
+        Ok(found)
+    }
+
+    fn medium_desc(&mut self, el: &'a Element) -> Result<MediumDesc, Error> {
+        let ty = el.attr("type").unwrap_or("");
+        if ty != "homogeneous" {
+            return Err(el.err(format!("medium plugin '{ty}' is not supported (homogeneous)")));
+        }
+        let p = Props::new(el);
+        for name in ["sigma_t", "albedo", "sigma_a", "sigma_s"] {
+            if let Some(e) = p.find(name) {
+                if e.tag == "volume" {
+                    return Err(e.err(format!(
+                        "homogeneous: '{name}' given as a <volume type=\"{}\"> is not supported (give a <float>, <rgb> or <spectrum>)",
+                        e.attr("type").unwrap_or("")
+                    )));
+                }
+            }
+        }
+        let coefficient = |name: &str, default: f32| -> Result<Rgb, Error> {
+            match p.find(name) {
+                None => Ok(Rgb::splat(default)),
+                Some(e) => {
+                    let e = self.resolve(e)?;
+                    let v = color_of(e, SpectrumUse::Reflectance)?;
+                    // Mitsuba reads these as reflectance-like textures, which reject RGB
+                    // values outside [0, 1] (its documentation: use `scale` for more).
+                    if e.tag == "rgb" && !v.to_array().iter().all(|x| (0.0..=1.0).contains(x)) {
+                        return Err(e.err(format!(
+                            "homogeneous: an <rgb> '{name}' must lie in [0, 1], as in Mitsuba (use 'scale' for denser media)"
+                        )));
+                    }
+                    Ok(v)
+                }
+            }
+        };
+        let split = p.find("sigma_a").is_some() || p.find("sigma_s").is_some();
+        let (sigma_t, albedo) = if split {
+            // Mitsuba 0.6's parametrisation, which glint also reads.
+            if p.find("sigma_t").is_some() || p.find("albedo").is_some() {
+                return Err(el.err("homogeneous: give either sigma_t and albedo or sigma_a and sigma_s, not both"));
+            }
+            let (a, s) = (coefficient("sigma_a", 0.0)?, coefficient("sigma_s", 0.0)?);
+            let t = a + s;
+            let albedo = Rgb { r: ratio(s.r, t.r), g: ratio(s.g, t.g), b: ratio(s.b, t.b) };
+            (t, albedo)
+        } else {
+            (coefficient("sigma_t", 1.0)?, coefficient("albedo", 0.75)?)
+        };
+        let scale = p.float("scale", 1.0)?;
+        let spectral = p.bool("has_spectral_extinction", true)?;
+        if !spectral && (sigma_t.r != sigma_t.g || sigma_t.g != sigma_t.b) {
+            self.warnings.push(
+                el.err(
+                    "homogeneous: has_spectral_extinction=false with a sigma_t that varies by channel: glint renders the \
+                     varying extinction exactly, where Mitsuba would sample one channel's distance without correcting \
+                     for the others",
+                )
+                .to_string(),
+            );
+        }
+        let sample_emitters = p.bool("sample_emitters", true)?;
+        let mut phase = PhaseDesc::Isotropic;
+        let mut phases = 0;
+        for c in &el.children {
+            let target = if c.tag == "ref" { self.resolve(c)? } else { c };
+            if target.tag == "phase" {
+                phases += 1;
+                if phases > 1 {
+                    return Err(c.err("only a single phase function can be specified per medium"));
+                }
+                phase = self.phase(target)?;
+            } else if target.tag == "volume" && c.attr("name").is_none() {
+                return Err(c.err("homogeneous: a <volume> needs a name (and grid volumes are not supported)"));
+            }
+        }
+        self.warn_unused(&p);
+        let name = el.attr("id").map_or_else(|| format!("medium@{}:{}", el.file.display(), el.line), str::to_string);
+        Ok(MediumDesc { name, sigma_t, albedo, scale, phase, sample_emitters, loc: el.loc() })
+    }
+
+    fn phase(&mut self, el: &'a Element) -> Result<PhaseDesc, Error> {
+        let p = Props::new(el);
+        let phase = match el.attr("type").unwrap_or("") {
+            "isotropic" => PhaseDesc::Isotropic,
+            "hg" => {
+                let g = p.float("g", 0.8)?;
+                if !(g > -1.0 && g < 1.0) {
+                    return Err(el.err(format!("hg: the asymmetry parameter g {g} must lie in (-1, 1)")));
+                }
+                PhaseDesc::Hg { g }
+            }
+            other => return Err(el.err(format!("phase function '{other}' is not supported (isotropic, hg)"))),
+        };
+        self.warn_unused(&p);
+        Ok(phase)
+    }
+}
+
+/// s / t, 0 where t is 0 (a channel with no extinction scatters nothing).
+fn ratio(s: f32, t: f32) -> f32 {
+    if t > 0.0 {
+        (s / t).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}

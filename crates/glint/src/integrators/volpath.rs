@@ -1,0 +1,338 @@
+//! Volumetric path tracing (Mitsuba's `volpath`): the path tracer of `path`, with media.
+//!
+//! A ray travelling in a medium either scatters before the next surface or reaches it. The
+//! free-flight distances of a path are drawn from one colour channel's exponential (the hero
+//! channel, chosen per path), and the path is weighted by its contribution over the mean of
+//! the three channels' path densities: spectral MIS with the balance heuristic over whole
+//! paths (as Mitsuba's `volpathmis`), unbiased in every channel and at most 3 times the
+//! channel's own estimate, where following one channel (Mitsuba's `volpath`) has no bound. At a scattering point the light is sampled (next-event estimation, with the
+//! transmittance along the shadow ray) and the phase function continues the path, the two
+//! combined by MIS as at surfaces. Surfaces with a `null` BSDF (and the straight-through
+//! lobe of a thin dielectric) are passages, not scattering events: paths go on through them
+//! without counting depth, and shadow rays pass through them, attenuated by every medium
+//! they cross. A shape that bounds media switches the ray's medium to the one on the side
+//! the ray leaves to. Surfaces without media behave exactly as in `path`.
+//!
+//! Depth counts scattering events (in media and at surfaces, not passages), as Mitsuba's
+//! `max_depth` does: 1 shows emitters seen directly (through any passages and media), 2
+//! adds single scattering, and so on. Transmittance along shadow rays is exact (homogeneous
+//! media): exp(-σt d) per channel and per medium crossed.
+
+use super::path::MAX_PATH_DEPTH;
+use super::{shading, shadow_ray, spawn_ray, Counters};
+use crate::bsdf::{fresnel_dielectric, Bsdf, BsdfSample};
+use crate::describe::VolpathSettings;
+use crate::lights::LightSample;
+use crate::materials::MaterialKind;
+use crate::math::{offset_origin, Ray, Rgb, Vec3};
+use crate::media::{sample_distance, Medium};
+use crate::sampling::{power_heuristic, Sampler};
+use crate::world::{SurfaceInteraction, World};
+
+/// The most passages (null boundaries, hidden emitters) one path or shadow ray makes; a
+/// ray that meets more (a stack of coincident boundaries) ends there.
+const MAX_PASSAGES: u32 = 256;
+
+pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
+    let max_depth = s.max_depth.unwrap_or(MAX_PATH_DEPTH).min(MAX_PATH_DEPTH);
+    if max_depth == 0 {
+        return Rgb::BLACK;
+    }
+    // Shadow rays must look for passages only where there are any.
+    let passable =
+        scene.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }))
+            || !scene.media.is_empty();
+    let mut l = Rgb::BLACK;
+    let mut throughput = Rgb::WHITE;
+    // Undoes the 1/eta^2 radiance scaling for Russian roulette, as in `path`.
+    let mut eta_scale = 1.0f32;
+    let mut ray = *camera_ray;
+    let mut medium = scene.camera_medium;
+    // The last scattering event: its direction density, whether it was delta (or could not
+    // have been sampled by lights), and where it was.
+    let mut prev_pdf = 1.0f32;
+    let mut prev_delta = true;
+    let mut prev_p = ray.origin;
+    let mut depth = 0u32; // scattering events so far
+    let mut passages = 0u32;
+    // The hero channel, and each channel's path density over their mean (`throughput` is the
+    // path contribution over that mean).
+    let channel = if scene.media.is_empty() { 0 } else { ((rng.next_f32() * 3.0) as usize).min(2) };
+    let mut density_ratio = Rgb::WHITE;
+
+    loop {
+        c.rays += 1;
+        let hit = scene.intersect(&ray);
+
+        if let Some(mi) = medium {
+            let m = &scene.media[mi as usize];
+            let t_max = hit.map_or(f32::INFINITY, |h| h.t);
+            let flight = sample_distance(m, t_max, channel, rng.next_f32());
+            let mean = (density_ratio * flight.density).average();
+            if !(mean > 0.0) {
+                break;
+            }
+            throughput = throughput * flight.value / mean;
+            density_ratio = density_ratio * flight.density / mean;
+            if throughput.is_black() {
+                break;
+            }
+            if let Some(t) = flight.t {
+                depth += 1;
+                if depth >= max_depth {
+                    break;
+                }
+                let p = ray.at(t);
+                let wo = -ray.dir;
+                if m.sample_emitters {
+                    l += throughput * light_at_medium_point(scene, m, p, wo, medium, passable, rng, c);
+                }
+                let ps = m.phase.sample(wo, rng.next_2d());
+                prev_pdf = ps.pdf;
+                // Without light sampling here, lights the phase sample reaches count fully.
+                prev_delta = !m.sample_emitters;
+                prev_p = p;
+                ray = Ray::new(p, ps.wi);
+                if !roulette(s, depth, &mut throughput, eta_scale, rng) {
+                    break;
+                }
+                continue;
+            }
+        }
+
+        let Some(hit) = hit else {
+            if !(depth == 0 && s.hide_emitters) {
+                for &li_idx in &scene.environment_lights {
+                    let light = &scene.lights[li_idx as usize];
+                    let le = light.environment(ray.dir);
+                    if le.is_black() {
+                        continue;
+                    }
+                    let w = emitter_weight(prev_delta, prev_pdf, || {
+                        scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, ray.origin, ray.dir)
+                    });
+                    l += throughput * le * w;
+                }
+            }
+            break;
+        };
+        let si = scene.interaction(&ray, &hit);
+        let boundary = scene.instances[si.instance as usize].media;
+
+        if let Some(li_idx) = si.light {
+            if depth == 0 && s.hide_emitters {
+                // Looked through, as `path` looks through hidden emitters.
+                passages += 1;
+                if passages > MAX_PASSAGES {
+                    break;
+                }
+                ray = spawn_ray(&si, ray.dir);
+                continue;
+            }
+            let light = &scene.lights[li_idx as usize];
+            let le = light.emitted(si.ng, ray.dir);
+            if !le.is_black() {
+                let w = emitter_weight(prev_delta, prev_pdf, || {
+                    scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, si.p, si.ng)
+                });
+                l += throughput * le * w;
+            }
+        }
+
+        let wo_world = -ray.dir;
+        let (bsdf, frame) = shading(scene, &si, wo_world);
+        let wo = frame.to_local(wo_world);
+
+        // Next-event estimation, when one more segment is allowed.
+        if !bsdf.is_delta() && depth + 1 < max_depth {
+            if let Some((ls, pick_pmf)) = sample_light(scene, si.p, rng) {
+                let wi = frame.to_local(ls.wi);
+                let f = bsdf.eval(wo, wi);
+                if !f.is_black() {
+                    let start = boundary.medium_after(ls.wi.dot(si.ng), medium);
+                    let tr = transmittance(scene, shadow_ray(&si, ls.wi, ls.dist), start, passable, c);
+                    if !tr.is_black() {
+                        let light_pdf = pick_pmf * ls.pdf;
+                        let w = if ls.delta { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
+                        l += throughput * f * ls.radiance * tr * (w / light_pdf);
+                    }
+                }
+            }
+        }
+
+        let u_lobe = rng.next_f32();
+        let u = rng.next_2d();
+        let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
+            break;
+        };
+        if bs.weight.is_black() {
+            break;
+        }
+        let passage = is_passage(&bsdf.bsdf, wo, &bs);
+        if !passage && depth + 1 >= max_depth {
+            break;
+        }
+        throughput *= bs.weight;
+        let wi_world = frame.to_world(bs.wi);
+        medium = boundary.medium_after(wi_world.dot(si.ng), medium);
+        ray = spawn_ray(&si, wi_world);
+        if passage {
+            passages += 1;
+            if passages > MAX_PASSAGES {
+                break;
+            }
+            continue;
+        }
+        depth += 1;
+        eta_scale *= bs.eta * bs.eta;
+        prev_pdf = bs.pdf;
+        prev_delta = bs.delta;
+        prev_p = si.p;
+        if !roulette(s, depth, &mut throughput, eta_scale, rng) {
+            break;
+        }
+    }
+    l
+}
+
+/// Russian roulette from `rr_depth` scattering events on; false when the path ends.
+#[inline]
+fn roulette(s: &VolpathSettings, depth: u32, throughput: &mut Rgb, eta_scale: f32, rng: &mut Sampler) -> bool {
+    if depth < s.rr_depth {
+        return true;
+    }
+    let q = (throughput.max_component() * eta_scale).min(0.95);
+    if !(q > 0.0) || rng.next_f32() >= q {
+        return false;
+    }
+    *throughput = *throughput / q;
+    true
+}
+
+/// One light sample from `p`, with the probability of having picked that light.
+fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
+    let dist = scene.light_distribution.as_ref()?;
+    let pick = dist.sample(rng.next_f32());
+    let ls = scene.lights[pick.index].sample_li(p, rng.next_2d())?;
+    if !(ls.pdf > 0.0) || ls.radiance.is_black() {
+        return None;
+    }
+    Some((ls, pick.pmf))
+}
+
+/// Next-event estimation at a scattering point `p` in medium `m` (index `medium`).
+#[allow(clippy::too_many_arguments)]
+fn light_at_medium_point(
+    scene: &World,
+    m: &Medium,
+    p: Vec3,
+    wo: Vec3,
+    medium: Option<u32>,
+    passable: bool,
+    rng: &mut Sampler,
+    c: &mut Counters,
+) -> Rgb {
+    let Some((ls, pick_pmf)) = sample_light(scene, p, rng) else {
+        return Rgb::BLACK;
+    };
+    let phase = m.phase.eval(wo, ls.wi);
+    if !(phase > 0.0) {
+        return Rgb::BLACK;
+    }
+    let ray = if ls.dist.is_finite() { Ray::segment(p, ls.wi, ls.dist * (1.0 - 1e-4)) } else { Ray::new(p, ls.wi) };
+    let tr = transmittance(scene, ray, medium, passable, c);
+    if tr.is_black() {
+        return Rgb::BLACK;
+    }
+    let light_pdf = pick_pmf * ls.pdf;
+    let w = if ls.delta { 1.0 } else { power_heuristic(light_pdf, phase) };
+    ls.radiance * tr * (phase * w / light_pdf)
+}
+
+/// The fraction of light that travels along the shadow ray `ray`, which starts in `medium`:
+/// zero when a surface that is not a passage blocks it, else the product of the media's
+/// transmittances and the passages' transmission.
+fn transmittance(scene: &World, mut ray: Ray, mut medium: Option<u32>, passable: bool, c: &mut Counters) -> Rgb {
+    c.shadow_rays += 1;
+    if !passable {
+        return if scene.occluded(&ray) { Rgb::BLACK } else { Rgb::WHITE };
+    }
+    let mut tr = Rgb::WHITE;
+    for _ in 0..=MAX_PASSAGES {
+        let hit = scene.intersect(&ray);
+        if let Some(m) = medium {
+            tr *= scene.media[m as usize].transmittance(hit.map_or(ray.t_max, |h| h.t));
+        }
+        let Some(hit) = hit else {
+            return tr;
+        };
+        if tr.is_black() {
+            return tr;
+        }
+        let si = scene.interaction(&ray, &hit);
+        let (bsdf, frame) = shading(scene, &si, -ray.dir);
+        let Some(pass) = passage_transmission(&bsdf.bsdf, frame.to_local(-ray.dir)) else {
+            return Rgb::BLACK;
+        };
+        tr *= pass;
+        if tr.is_black() {
+            return tr;
+        }
+        medium = scene.instances[si.instance as usize].media.medium_after(ray.dir.dot(si.ng), medium);
+        ray = next_segment(&si, &ray, hit.t);
+        c.shadow_rays += 1;
+    }
+    Rgb::BLACK
+}
+
+/// The rest of a shadow ray after it passed a surface at distance `t`.
+fn next_segment(si: &SurfaceInteraction, ray: &Ray, t: f32) -> Ray {
+    let o = offset_origin(si.p, si.ng, ray.dir);
+    if !ray.t_max.is_finite() {
+        return Ray::new(o, ray.dir);
+    }
+    let target = ray.at(ray.t_max);
+    let to_target = target - o;
+    let len = to_target.length();
+    if !(len > 0.0) || to_target.dot(ray.dir) <= 0.0 || t >= ray.t_max {
+        return Ray::segment(o, ray.dir, 0.0);
+    }
+    Ray::segment(o, to_target / len, len)
+}
+
+/// What a passage lets straight through towards `-wo`: all of it for `null`, the summed
+/// transmission of a thin dielectric (Mitsuba's null transmission); `None` for surfaces
+/// that are not passages.
+fn passage_transmission(bsdf: &Bsdf, wo: Vec3) -> Option<Rgb> {
+    match bsdf {
+        Bsdf::Null => Some(Rgb::WHITE),
+        Bsdf::ThinDielectric { eta, transmit, .. } => {
+            let mut r = fresnel_dielectric(wo.z.abs(), *eta).reflectance;
+            if r < 1.0 {
+                r *= 2.0 / (1.0 + r);
+            }
+            Some(*transmit * (1.0 - r))
+        }
+        _ => None,
+    }
+}
+
+/// Whether a BSDF sample went straight through a passage (not a scattering event).
+fn is_passage(bsdf: &Bsdf, wo: Vec3, bs: &BsdfSample) -> bool {
+    match bsdf {
+        Bsdf::Null => true,
+        Bsdf::ThinDielectric { .. } => bs.delta && bs.wi == -wo,
+        _ => false,
+    }
+}
+
+/// MIS weight of an emitter reached by a sampled direction (`light_pdf` evaluated only when
+/// needed).
+#[inline]
+fn emitter_weight(prev_delta: bool, prev_pdf: f32, light_pdf: impl FnOnce() -> f32) -> f32 {
+    if prev_delta {
+        1.0
+    } else {
+        power_heuristic(prev_pdf, light_pdf())
+    }
+}
