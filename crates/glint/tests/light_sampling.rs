@@ -42,7 +42,7 @@ struct Case {
 }
 
 fn sphere_case(label: &'static str, center: Vec3, radius: f32, p: Vec3) -> Case {
-    let s = Sphere { center, radius };
+    let s = Sphere::new(center, radius);
     let d = (center - p).length();
     let hit: Hit = Box::new(move |o, w| {
         let t = s.intersect(&Ray::new(o, w))?;

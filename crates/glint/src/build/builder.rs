@@ -279,7 +279,9 @@ impl WorldBuilder {
         if !(r > 0.0 && r.is_finite()) {
             return Err(format!("sphere radius must be positive, got {r}"));
         }
-        let sphere = Sphere { center: c, radius: r };
+        // The rotation (or reflection) part of the transform orients the sphere's uvs.
+        let axes = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| to_world.vector(a).normalize());
+        let sphere = Sphere { center: c, radius: r, axes };
         let id = self.spheres.len() as u32;
         self.spheres.push(sphere);
         let instance = self.instances.len() as u32;

@@ -1,5 +1,5 @@
-//! Analytic spheres, stored in world space (a sphere's transform is folded into its centre
-//! and radius when the scene is built; a non-uniform scale is rejected there).
+//! Analytic spheres, stored in world space (a sphere's transform is folded into its centre,
+//! radius and axes when the scene is built; a non-uniform scale is rejected there).
 
 use crate::math::{Aabb, Ray, Vec3};
 
@@ -7,9 +7,29 @@ use crate::math::{Aabb, Ray, Vec3};
 pub struct Sphere {
     pub center: Vec3,
     pub radius: f32,
+    /// World directions of the sphere's own x, y and z axes (unit length): its uv
+    /// parameterisation (Mitsuba's, about the local z axis) turns with its transform.
+    pub axes: [Vec3; 3],
 }
 
 impl Sphere {
+    /// A sphere with the world's axes.
+    pub fn new(center: Vec3, radius: f32) -> Sphere {
+        Sphere { center, radius, axes: [Vec3::X, Vec3::Y, Vec3::Z] }
+    }
+
+    /// The world direction `n` in the sphere's own axes.
+    #[inline]
+    pub fn to_local(&self, n: Vec3) -> Vec3 {
+        Vec3 { x: n.dot(self.axes[0]), y: n.dot(self.axes[1]), z: n.dot(self.axes[2]) }
+    }
+
+    /// A direction in the sphere's own axes, in the world.
+    #[inline]
+    pub fn to_world(&self, l: Vec3) -> Vec3 {
+        self.axes[0] * l.x + self.axes[1] * l.y + self.axes[2] * l.z
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb { min: self.center - Vec3::splat(self.radius), max: self.center + Vec3::splat(self.radius) }
     }
@@ -52,7 +72,7 @@ mod tests {
 
     #[test]
     fn hits_front_then_back_from_inside() {
-        let s = Sphere { center: vec3(0.0, 0.0, 10.0), radius: 2.0 };
+        let s = Sphere::new(vec3(0.0, 0.0, 10.0), 2.0);
         let r = Ray::new(Vec3::ZERO, vec3(0.0, 0.0, 1.0));
         assert!((s.intersect(&r).unwrap() - 8.0).abs() < 1e-5);
         let inside = Ray::new(vec3(0.0, 0.0, 10.0), vec3(0.0, 0.0, 2.0));
@@ -61,7 +81,7 @@ mod tests {
 
     #[test]
     fn far_sphere_is_still_accurate() {
-        let s = Sphere { center: vec3(0.0, 0.0, 1.0e4), radius: 1.0 };
+        let s = Sphere::new(vec3(0.0, 0.0, 1.0e4), 1.0);
         let r = Ray::new(Vec3::ZERO, vec3(0.0, 0.0, 1.0));
         assert!((s.intersect(&r).unwrap() - 9999.0).abs() < 1e-2);
     }

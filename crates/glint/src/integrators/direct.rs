@@ -57,9 +57,11 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
     if !bsdf.is_delta() {
         if let Some(dist) = &scene.light_distribution {
             for _ in 0..s.emitter_samples {
-                let pick = dist.sample(rng.next_f32());
+                // The light and the point on it from one 2D point (see path.rs).
+                let u = rng.next_2d();
+                let pick = dist.sample(u[0]);
                 let light = &scene.lights[pick.index];
-                let Some(ls) = light.sample_li(si.p, rng.next_2d()) else {
+                let Some(ls) = light.sample_li(si.p, [pick.remapped, u[1]]) else {
                     continue;
                 };
                 if !(ls.pdf > 0.0) || ls.radiance.is_black() {

@@ -100,10 +100,13 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
         // Next-event estimation: one light, chosen by the scene's light distribution.
         if s.strategy != Strategy::Bsdf && !bsdf.is_delta() {
             if let Some(dist) = &scene.light_distribution {
-                let pick = dist.sample(rng.next_f32());
-                let light = &scene.lights[pick.index];
+                // One 2D point picks the light (its first coordinate, rescaled) and the point
+                // on it, as Mitsuba does: the sampler's 2D stratification then holds within
+                // each light's share of the samples.
                 let u = rng.next_2d();
-                if let Some(ls) = light.sample_li(si.p, u) {
+                let pick = dist.sample(u[0]);
+                let light = &scene.lights[pick.index];
+                if let Some(ls) = light.sample_li(si.p, [pick.remapped, u[1]]) {
                     if ls.pdf > 0.0 && !ls.radiance.is_black() {
                         let wi = frame.to_local(ls.wi);
                         let f = bsdf.eval(wo, wi);

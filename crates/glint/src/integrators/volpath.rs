@@ -212,8 +212,10 @@ fn roulette(s: &VolpathSettings, depth: u32, throughput: &mut Rgb, eta_scale: f3
 /// One light sample from `p`, with the probability of having picked that light.
 fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
     let dist = scene.light_distribution.as_ref()?;
-    let pick = dist.sample(rng.next_f32());
-    let ls = scene.lights[pick.index].sample_li(p, rng.next_2d())?;
+    // The light and the point on it from one 2D point (see path.rs).
+    let u = rng.next_2d();
+    let pick = dist.sample(u[0]);
+    let ls = scene.lights[pick.index].sample_li(p, [pick.remapped, u[1]])?;
     if !(ls.pdf > 0.0) || ls.radiance.is_black() {
         return None;
     }

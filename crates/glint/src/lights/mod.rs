@@ -304,7 +304,7 @@ mod tests {
 
     #[test]
     fn sphere_lights_are_sampled_only_from_the_side_they_light() {
-        let sphere = Sphere { center: Vec3::ZERO, radius: 1.0 };
+        let sphere = Sphere::new(Vec3::ZERO, 1.0);
         let light = |inward| Light::Sphere { instance: 0, sphere, radiance: Rgb::WHITE, inward };
         let (outside, inside) = (vec3(0.0, 0.0, 3.0), vec3(0.2, 0.1, 0.0));
         for u in [[0.1, 0.2], [0.5, 0.5], [0.9, 0.7]] {

@@ -106,7 +106,7 @@ mod tests {
     #[test]
     fn a_distant_small_sphere_keeps_its_cone() {
         // sin²θmax = 1e-10: the plain 1 - cos θmax is 0 in f32.
-        let s = Sphere { center: vec3(0.0, 0.0, 1e5), radius: 1.0 };
+        let s = Sphere::new(vec3(0.0, 0.0, 1e5), 1.0);
         let c = cone(&s, Vec3::ZERO).unwrap();
         let exact = 1e-10f64 / (1.0 + (1.0 - 1e-10f64).sqrt());
         assert!((c.one_minus_cos_max as f64 / exact - 1.0).abs() < 1e-6, "{}", c.one_minus_cos_max);

@@ -294,13 +294,14 @@ impl World {
                 let n = (p - sph.center) / sph.radius;
                 // Re-project onto the surface to remove the error of the root.
                 p = sph.center + n * sph.radius;
-                let local = n;
+                let local = sph.to_local(n);
                 let theta = local.z.clamp(-1.0, 1.0).acos();
                 let mut phi = local.y.atan2(local.x);
                 if phi < 0.0 {
                     phi += 2.0 * std::f32::consts::PI;
                 }
                 let (dpdu, dpdv) = sphere_dpduv(local, sph.radius);
+                let (dpdu, dpdv) = (sph.to_world(dpdu), sph.to_world(dpdv));
                 (p, n, None, [phi / (2.0 * std::f32::consts::PI), theta / std::f32::consts::PI], dpdu, dpdv)
             }
         };
