@@ -71,6 +71,16 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
                     return Err(Error::at(&s.loc, format!("sphere radius {radius} must be positive and finite")));
                 }
             }
+            Geometry::Cylinder { p0, p1, radius } => {
+                vector(*p0, "cylinder p0").map_err(|m| Error::at(&s.loc, m))?;
+                vector(*p1, "cylinder p1").map_err(|m| Error::at(&s.loc, m))?;
+                if !(*radius > 0.0 && radius.is_finite()) {
+                    return Err(Error::at(&s.loc, format!("cylinder radius {radius} must be positive and finite")));
+                }
+                if !((*p1 - *p0).length() > 0.0) {
+                    return Err(Error::at(&s.loc, "cylinder: p0 and p1 must differ"));
+                }
+            }
             Geometry::Mesh(m) => {
                 if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
                     return Err(Error::at(&s.loc, format!("mesh vertex {i} is not finite")));

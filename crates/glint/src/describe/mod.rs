@@ -176,6 +176,9 @@ pub struct MeshFileDesc {
     pub file: PathBuf,
     pub face_normals: bool,
     pub loc: SourceLoc,
+    /// Which mesh of a `.serialized` file (Mitsuba's `shape_index`); 0 for other files.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub shape_index: u32,
 }
 
 /// Which material a shape uses.
@@ -235,6 +238,13 @@ pub enum Geometry {
     Cube,
     /// The unit disk in the z = 0 plane, facing +z.
     Disk,
+    /// An open tube (no end caps) of `radius` around the segment `p0` to `p1`, its normals
+    /// outward (Mitsuba's `cylinder`).
+    Cylinder {
+        p0: Vec3,
+        p1: Vec3,
+        radius: f32,
+    },
 }
 
 fn is_zero(v: &u32) -> bool {
@@ -471,6 +481,7 @@ mod tests {
             file: "bunny.ply".into(),
             face_normals: false,
             loc: SourceLoc::default(),
+            shape_index: 0,
         });
         for file in ["box.obj", "bunny.ply"] {
             d.shapes.push(ShapeDesc {

@@ -240,6 +240,10 @@ struct JsonShape {
     flip_normals: bool,
     #[serde(default)]
     face_normals: bool,
+    #[serde(default)]
+    p0: Option<[f32; 3]>,
+    #[serde(default)]
+    p1: Option<[f32; 3]>,
 }
 
 #[derive(Deserialize)]
@@ -576,6 +580,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             file: ctx.resolve(&m.file),
             face_normals: m.face_normals,
             loc: ctx.loc(&format!("meshes/{name}")),
+            shape_index: 0,
         });
     }
 
@@ -613,11 +618,16 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             "rectangle" => Geometry::Rectangle,
             "cube" => Geometry::Cube,
             "disk" => Geometry::Disk,
+            "cylinder" => Geometry::Cylinder {
+                p0: Vec3::from_array(s.p0.unwrap_or([0.0; 3])),
+                p1: Vec3::from_array(s.p1.unwrap_or([0.0, 0.0, 1.0])),
+                radius: s.radius.unwrap_or(1.0),
+            },
             other => {
                 return Err(ctx.err(
                     &format!("{at}/type"),
                     format!(
-                        "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk)"
+                        "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk, cylinder)"
                     ),
                 ))
             }

@@ -1,8 +1,10 @@
-//! Shapes: triangle meshes (with their own BVH) and analytic spheres.
+//! Shapes: triangle meshes (with their own BVH), analytic spheres and cylinders.
 
+mod cylinder;
 mod mesh;
 mod sphere;
 
+pub use cylinder::{Cylinder, CylinderPoint};
 pub use mesh::{
     cube_mesh, disk_mesh, quad_mesh, rectangle_mesh, AccelStats, MeshAccel, TriangleMesh, WideTris, DISK_SEGMENTS,
 };

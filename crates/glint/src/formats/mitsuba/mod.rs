@@ -4,6 +4,7 @@
 //! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
 //! an error that names the plugin, the file and the line.
 
+mod instances;
 mod props;
 mod spectrum;
 pub mod xml;
@@ -63,6 +64,8 @@ struct Reader<'a> {
     materials: Vec<MaterialDesc>,
     shapes: Vec<ShapeDesc>,
     lights: Vec<LightDesc>,
+    /// Mesh files placed by `instance`s of shape groups, each loaded once.
+    meshes: Vec<crate::describe::MeshFileDesc>,
     warnings: Vec<String>,
     /// Errors found so far: a scene's unsupported features are all reported, one a line.
     errors: Vec<Error>,
@@ -109,6 +112,7 @@ fn describe_tree<'a>(
         materials: Vec::new(),
         shapes: Vec::new(),
         lights: Vec::new(),
+        meshes: Vec::new(),
         warnings: tree.warnings.clone(),
         errors: Vec::new(),
     };
@@ -158,6 +162,7 @@ fn describe_tree<'a>(
     desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp, seed };
     desc.materials = r.materials;
     desc.shapes = r.shapes;
+    desc.meshes = r.meshes;
     desc.lights = r.lights;
     desc.warnings = r.warnings;
     Ok(desc)
@@ -404,9 +409,22 @@ impl<'a> Reader<'a> {
     }
 
     fn shape(&mut self, el: &'a Element) -> Result<(), Error> {
+        match el.attr("type").unwrap_or("") {
+            "shapegroup" => self.shape_group(el),
+            "instance" => self.instance(el),
+            _ => self.placed_shape(el, None),
+        }
+    }
+
+    /// A shape, placed by its `to_world` and then (inside a shape group) by the instance's.
+    fn placed_shape(&mut self, el: &'a Element, instance_to_world: Option<&Transform>) -> Result<(), Error> {
         let p = Props::new(el);
         let ty = el.attr("type").unwrap_or("");
-        let to_world = p.transform("to_world")?;
+        let own_to_world = p.transform("to_world")?;
+        let to_world = match instance_to_world {
+            Some(t) => t.then_after(&own_to_world),
+            None => own_to_world,
+        };
         let flip_normals = p.bool("flip_normals", false)?;
         // BSDF: a nested <bsdf> or a <ref> to one.
         let mut material = None;
@@ -437,6 +455,11 @@ impl<'a> Reader<'a> {
                 let path = self.resolve_file(el, file);
                 Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)?, shape_index: 0 }
             }
+            "cylinder" => Geometry::Cylinder {
+                p0: p.point("p0")?.unwrap_or(Vec3::ZERO),
+                p1: p.point("p1")?.unwrap_or(Vec3::Z),
+                radius: p.float("radius", 1.0)?,
+            },
             "serialized" => {
                 let file = p.string("filename").ok_or_else(|| el.err("shape 'serialized' needs 'filename'"))?;
                 let path = self.resolve_file(el, file);
@@ -467,6 +490,14 @@ impl<'a> Reader<'a> {
         if self.errors.len() > errors_before {
             return Ok(());
         }
+        // Meshes of a shape group are loaded once and traced through each instance's
+        // transform (as Mitsuba shares a group's BVH among its instances).
+        let geometry = match (instance_to_world, geometry) {
+            (Some(_), Geometry::MeshFile { file, face_normals, shape_index }) => {
+                Geometry::Instance { mesh: self.shared_mesh(el, file, face_normals, shape_index) }
+            }
+            (_, g) => g,
+        };
         self.shapes.push(ShapeDesc {
             geometry,
             to_world: matrix(&to_world),
