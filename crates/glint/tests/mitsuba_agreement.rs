@@ -165,3 +165,28 @@ fn serialized_meshes() {
 fn disk_polar_uv() {
     check("disk");
 }
+
+/// The cylinder: p0/p1/radius and to_world, Mitsuba's uv, one- and two-sided, flip_normals.
+#[test]
+fn cylinder_shape() {
+    check("cylinder");
+}
+
+/// shapegroup and instance: a group of a serialized mesh, a sphere and a cube drawn three
+/// times through the instances' transforms.
+#[test]
+fn shapegroup_instances() {
+    check("instance");
+}
+
+/// The orthographic sensor: a scaled to_world, a film that is not square, near and far clip.
+#[test]
+fn orthographic_sensor() {
+    check("orthographic");
+}
+
+/// A film crop window: the output is the window, with the full render's pixels there.
+#[test]
+fn film_crop_window() {
+    check("crop");
+}

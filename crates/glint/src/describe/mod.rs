@@ -9,7 +9,7 @@
 //! it, made before the build.
 
 use crate::bsdf::MicrofacetKind;
-use crate::camera::FovAxis;
+use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::error::SourceLoc;
 use crate::lights::LightSelection;
 use crate::math::{Rgb, Vec3};
@@ -60,6 +60,9 @@ pub struct CameraDesc {
     /// `f32::MAX` for none (JSON has no infinity).
     pub far_clip: f32,
     pub loc: SourceLoc,
+    /// Perspective (the field of view and lens above) or orthographic (they are unused).
+    #[serde(default)]
+    pub projection: Projection,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,6 +71,9 @@ pub struct FilmDesc {
     pub height: u32,
     pub filter: PixelFilter,
     pub loc: SourceLoc,
+    /// Render only this part of the `width` x `height` image (Mitsuba's crop window).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crop: Option<CropWindow>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -295,6 +301,24 @@ pub enum LightKind {
         scale: f32,
         to_world: Matrix4,
     },
+    /// A spot light projecting a texture (Mitsuba's `spot` with `texture`), at the origin
+    /// of `to_world` looking along its +z; its rotation about that axis turns the texture.
+    TexturedSpot {
+        to_world: Matrix4,
+        intensity: Rgb,
+        cutoff_degrees: f32,
+        beam_degrees: f32,
+        texture: TextureDesc,
+    },
+    /// Mitsuba's `projector`: a pinhole projecting `irradiance` with the field of view of
+    /// a camera whose film has the texture's aspect ratio.
+    Projector {
+        to_world: Matrix4,
+        irradiance: TextureDesc,
+        scale: f32,
+        fov_degrees: f32,
+        fov_axis: FovAxis,
+    },
 }
 
 impl SceneDesc {
@@ -354,8 +378,11 @@ impl SceneDesc {
             }
         }
         for l in &self.lights {
-            if let LightKind::EnvMap { file, .. } = &l.light {
-                add(file);
+            match &l.light {
+                LightKind::EnvMap { file, .. } => add(file),
+                LightKind::TexturedSpot { texture: TextureDesc::Bitmap { file, .. }, .. }
+                | LightKind::Projector { irradiance: TextureDesc::Bitmap { file, .. }, .. } => add(file),
+                _ => {}
             }
         }
         out
@@ -428,6 +455,7 @@ impl Default for CameraDesc {
             near_clip: 0.0,
             far_clip: f32::MAX,
             loc: SourceLoc::default(),
+            projection: Projection::Perspective,
         }
     }
 }
@@ -440,7 +468,7 @@ mod tests {
     fn round_trips_through_json() {
         let mut d = SceneDesc::empty(
             CameraDesc::default(),
-            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default() },
+            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None },
         );
         d.shapes.push(ShapeDesc {
             geometry: Geometry::Sphere { center: Vec3::ZERO, radius: 1.0 },
@@ -459,7 +487,7 @@ mod tests {
     fn desc_with_files() -> SceneDesc {
         let mut d = SceneDesc::empty(
             CameraDesc::default(),
-            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default() },
+            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None },
         );
         d.source = Some("scene.xml".into());
         d.includes.push("part.xml".into());

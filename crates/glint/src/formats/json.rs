@@ -6,7 +6,7 @@
 
 use super::json_spans::Spans;
 use crate::bsdf::MicrofacetKind;
-use crate::camera::FovAxis;
+use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
     CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
     MaterialModel, MaterialRef, Matrix4, MeshFileDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc,
@@ -54,6 +54,12 @@ struct JsonCamera {
     aperture_radius: f32,
     #[serde(default)]
     focus_distance: Option<f32>,
+    /// `perspective` (default) or `orthographic`.
+    #[serde(default)]
+    projection: Option<String>,
+    /// Orthographic: half the width of the view, in scene units (default 1).
+    #[serde(default)]
+    ortho_half_width: Option<f32>,
 }
 
 fn default_up() -> [f32; 3] {
@@ -67,6 +73,9 @@ struct JsonFilm {
     height: u64,
     #[serde(default)]
     filter: Option<String>,
+    /// Render only [offset_x, offset_y, width, height] of the image.
+    #[serde(default)]
+    crop: Option<[u64; 4]>,
 }
 
 #[derive(Deserialize)]
@@ -474,6 +483,25 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         Some(f) => f,
         None => (Vec3::from_array(cam.look_at) - Vec3::from_array(cam.position)).length(),
     };
+    let projection = match cam.projection.as_deref() {
+        None | Some("perspective") => Projection::Perspective,
+        Some("orthographic") => Projection::Orthographic,
+        Some(other) => {
+            return Err(
+                ctx.err("camera/projection", format!("unknown projection '{other}' (perspective, orthographic)"))
+            )
+        }
+    };
+    let to_world = match (projection, cam.ortho_half_width) {
+        (Projection::Orthographic, Some(s)) => {
+            let scale = Transform::scale(Vec3 { x: s, y: s, z: 1.0 }).filter(|_| s > 0.0 && s.is_finite());
+            let scale = scale.ok_or_else(|| {
+                ctx.err("camera/ortho_half_width", format!("ortho_half_width {s} must be positive and finite"))
+            })?;
+            to_world.then_after(&scale)
+        }
+        _ => to_world,
+    };
     let camera = CameraDesc {
         to_world: Some(to_world.m.0),
         fov_degrees: cam.fov,
@@ -483,6 +511,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         near_clip: 0.0,
         far_clip: f32::MAX,
         loc: ctx.loc("camera"),
+        projection,
     };
     let filter = match file.film.filter.as_deref() {
         None | Some("box") => PixelFilter::Box,
@@ -492,7 +521,16 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
     };
     let (width, height) = (file.film.width.min(u32::MAX as u64) as u32, file.film.height.min(u32::MAX as u64) as u32);
     crate::describe::limits::check_resolution(width, height).map_err(|e| ctx.err("film", e))?;
-    let film = FilmDesc { width, height, filter, loc: ctx.loc("film") };
+    let film = FilmDesc {
+        width,
+        height,
+        filter,
+        loc: ctx.loc("film"),
+        crop: file.film.crop.map(|[x, y, w, h]| {
+            let n = |v: u64| v.min(u32::MAX as u64) as u32;
+            CropWindow { offset_x: n(x), offset_y: n(y), width: n(w), height: n(h) }
+        }),
+    };
     let mut desc = SceneDesc::empty(camera, film);
     desc.source = Some(path.to_path_buf());
 

@@ -59,6 +59,11 @@ impl<'a> Reader<'a> {
                 ));
             }
         }
+        if to_world.swaps_handedness() {
+            // Mitsuba keeps an instanced shape's normals outward through a mirror; glint's
+            // instanced and baked meshes turn with the winding instead.
+            return Err(el.err("an instance transform that mirrors (negative determinant) is not supported"));
+        }
         self.warn_unused(&p);
         // The group's errors were reported where it stands; its good shapes are drawn.
         for c in group.children.iter().filter(|c| c.tag == "shape") {

@@ -5,13 +5,14 @@
 //! an error that names the plugin, the file and the line.
 
 mod instances;
+mod projected;
 mod props;
 mod spectrum;
 pub mod xml;
 
 use super::Define;
 use crate::bsdf::MicrofacetKind;
-use crate::camera::FovAxis;
+use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
     CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
     MaterialRef, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, TextureDesc,
@@ -231,6 +232,21 @@ fn settings_spp(sampler: Option<&Element>) -> Result<Option<u32>, Error> {
         return Ok(Some(n as u32));
     }
     Ok(None)
+}
+
+/// `hdrfilm`'s crop window (`crop_offset_x/y`, default 0; `crop_width/height`, default the
+/// rest of the film), checked as Mitsuba checks it; `None` when it is the whole film.
+fn film_crop(fp: &Props, width: u32, height: u32) -> Result<Option<CropWindow>, Error> {
+    let (ox, oy) = (fp.int("crop_offset_x", 0)?, fp.int("crop_offset_y", 0)?);
+    let (cw, ch) = (fp.int("crop_width", width as i64 - ox)?, fp.int("crop_height", height as i64 - oy)?);
+    let fits = |o: i64, s: i64, full: u32| o >= 0 && s >= 1 && o + s <= full as i64;
+    if !fits(ox, cw, width) || !fits(oy, ch, height) {
+        return Err(fp.el.err(format!(
+            "the crop window ({cw}x{ch} at {ox}, {oy}) must be at least one pixel and lie within the {width}x{height} film"
+        )));
+    }
+    let crop = CropWindow { offset_x: ox as u32, offset_y: oy as u32, width: cw as u32, height: ch as u32 };
+    Ok((crop != CropWindow { offset_x: 0, offset_y: 0, width, height }).then_some(crop))
 }
 
 fn matrix(t: &Transform) -> crate::describe::Matrix4 {
@@ -535,10 +551,9 @@ impl<'a> Reader<'a> {
                 },
                 intensity: p.rgb_as("intensity", Rgb::WHITE, SpectrumUse::Emission)?,
             },
+            "spot" if p.find("texture").is_some() => self.textured_spot(&p, &to_world)?,
+            "projector" => self.projector(&p, &to_world)?,
             "spot" => {
-                if p.find("texture").is_some() {
-                    return Err(el.err("spot: projected textures are not supported"));
-                }
                 let cutoff = p.float("cutoff_angle", 20.0)?;
                 LightKind::Spot {
                     position: to_world.point(Vec3::ZERO),
@@ -596,12 +611,15 @@ impl<'a> Reader<'a> {
         sampler_el: Option<&'a Element>,
     ) -> Result<(CameraDesc, FilmDesc, u64), Error> {
         let ty = el.attr("type").unwrap_or("");
-        if ty != "perspective" && ty != "thinlens" {
-            return Err(el.err(format!("sensor plugin '{ty}' is not supported (perspective, thinlens)")));
+        if !matches!(ty, "perspective" | "thinlens" | "orthographic") {
+            return Err(el.err(format!("sensor plugin '{ty}' is not supported (perspective, thinlens, orthographic)")));
         }
         let p = Props::new(el);
         let to_world = p.transform("to_world")?;
-        let fov = match (p.opt_float("fov")?, p.string("focal_length")) {
+        let orthographic = ty == "orthographic";
+        // An orthographic camera has no field of view (its fov is an unused placeholder).
+        let fov_given = if orthographic { (Some(45.0), None) } else { (p.opt_float("fov")?, p.string("focal_length")) };
+        let fov = match fov_given {
             (Some(f), _) => f,
             (None, Some(fl)) => {
                 let mm: f32 =
@@ -611,13 +629,19 @@ impl<'a> Reader<'a> {
             }
             (None, None) => 2.0 * (43.266_615f32 / (2.0 * 50.0)).atan().to_degrees(),
         };
-        let fov_axis: FovAxis = match p.string("fov_axis") {
-            Some(a) => a.parse().map_err(|e: String| el.err(e))?,
-            None if p.opt_float("fov")?.is_some() => FovAxis::X,
-            None => FovAxis::Diagonal,
+        let fov_axis: FovAxis = match (orthographic, p.string("fov_axis")) {
+            (true, _) => FovAxis::X,
+            (false, Some(a)) => a.parse().map_err(|e: String| el.err(e))?,
+            (false, None) if p.opt_float("fov")?.is_some() => FovAxis::X,
+            (false, None) => FovAxis::Diagonal,
         };
-        let mut film =
-            FilmDesc { width: 768, height: 576, filter: PixelFilter::Gaussian { stddev: 0.5 }, loc: el.loc() };
+        let mut film = FilmDesc {
+            width: 768,
+            height: 576,
+            filter: PixelFilter::Gaussian { stddev: 0.5 },
+            loc: el.loc(),
+            crop: None,
+        };
         if let Some(f) = film_el {
             if f.attr("type") != Some("hdrfilm") {
                 return Err(f.err(format!("film plugin '{}' is not supported (hdrfilm)", f.attr("type").unwrap_or(""))));
@@ -647,9 +671,7 @@ impl<'a> Reader<'a> {
                     other => return Err(rf.err(format!("rfilter '{other}' is not supported (box, tent, gaussian)"))),
                 };
             }
-            if fp.find("crop_width").is_some() || fp.find("crop_offset_x").is_some() {
-                return Err(f.err("film cropping is not supported"));
-            }
+            film.crop = film_crop(&fp, film.width, film.height)?;
             self.warn_unused(&fp);
         }
         let mut camera = CameraDesc {
@@ -661,6 +683,7 @@ impl<'a> Reader<'a> {
             near_clip: p.float("near_clip", 1e-2)?,
             far_clip: p.float("far_clip", 1e4)?,
             loc: el.loc(),
+            projection: if orthographic { Projection::Orthographic } else { Projection::Perspective },
         };
         // Perspective cameras accept (and, like Mitsuba, ignore) a focus distance.
         let _ = p.opt_float("focus_distance")?;
