@@ -190,3 +190,9 @@ fn orthographic_sensor() {
 fn film_crop_window() {
     check("crop");
 }
+
+/// Lights that project a texture: a projector and a textured spot.
+#[test]
+fn projector_and_textured_spot() {
+    check("projector");
+}

@@ -464,6 +464,11 @@ impl<'a> Reader<'a> {
             };
             self.note(result);
         }
+        if ty == "cylinder" && emission.is_some() {
+            self.note::<()>(
+                Err(el.err("an emitting cylinder is not supported (give the emitter to a mesh or sphere)")),
+            );
+        }
         let material = material.map_or(MaterialRef::DefaultDiffuse, MaterialRef::Index);
         let geometry = match ty {
             "obj" | "ply" => {
@@ -534,6 +539,9 @@ impl<'a> Reader<'a> {
             )));
         }
         let ep = Props::new(c);
+        if ep.find("radiance").and_then(|e| self.resolve(e).ok()).is_some_and(|e| e.tag == "texture") {
+            return Err(c.err("area: a textured 'radiance' is not supported (give a colour)"));
+        }
         let emission =
             Emission { radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?, two_sided: false };
         self.warn_unused(&ep);
