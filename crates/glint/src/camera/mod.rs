@@ -186,4 +186,39 @@ mod tests {
         let top = cam.generate_ray(50.0, 0.0, [0.5, 0.5]).dir;
         assert!((top.y.atan2(top.z).to_degrees() - 20.0).abs() < 1e-3);
     }
+
+    #[test]
+    fn orthographic_rays_are_parallel_and_span_mitsubas_window() {
+        let t = Transform::look_at(vec3(0.0, 0.0, -5.0), Vec3::ZERO, Vec3::Y).unwrap();
+        let scaled = t.then_after(&Transform::scale(vec3(2.0, 2.0, 1.0)).unwrap());
+        let mut cam = Camera::new(scaled, 100, 50, 40.0, FovAxis::X);
+        cam.projection = Projection::Orthographic;
+        cam.near_clip = 0.5;
+        cam.far_clip = 10.0;
+        for (x, y) in [(0.0, 0.0), (50.0, 25.0), (100.0, 50.0), (13.0, 41.0)] {
+            let r = cam.generate_ray(x, y, [0.5, 0.5]);
+            assert!((r.dir - Vec3::Z).length() < 1e-6);
+            assert!((r.origin.z - (-4.5)).abs() < 1e-5);
+            assert_eq!((r.t_min, r.t_max), (0.0, 9.5));
+        }
+        // Left edge: camera x = +1 (world +x here), scaled by 2; top edge: y = 1/aspect = 0.5.
+        assert!((cam.generate_ray(0.0, 25.0, [0.5; 2]).origin.x - 2.0).abs() < 1e-5);
+        assert!((cam.generate_ray(50.0, 0.0, [0.5; 2]).origin.y - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_crop_window_traces_the_full_images_rays() {
+        let t = Transform::look_at(vec3(1.0, 2.0, -5.0), Vec3::ZERO, Vec3::Y).unwrap();
+        for projection in [Projection::Perspective, Projection::Orthographic] {
+            let mut full = Camera::new(t, 64, 48, 50.0, FovAxis::X);
+            full.projection = projection;
+            let mut crop = full.clone();
+            crop.set_crop(CropWindow { offset_x: 10, offset_y: 7, width: 20, height: 30 });
+            assert_eq!((crop.width, crop.height), (20, 30));
+            for (x, y) in [(0.0, 0.0), (19.5, 29.5), (3.25, 11.0)] {
+                let (a, b) = (crop.generate_ray(x, y, [0.5; 2]), full.generate_ray(x + 10.0, y + 7.0, [0.5; 2]));
+                assert!((a.origin - b.origin).length() < 1e-6 && (a.dir - b.dir).length() < 1e-6);
+            }
+        }
+    }
 }

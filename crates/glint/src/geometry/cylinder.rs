@@ -169,7 +169,7 @@ mod tests {
         assert!((r.at(t).z - 1.0).abs() < 1e-5 && (r.at(t).x - 1.0).abs() < 1e-5);
         // A ray that grazes the outside of the near wall through the top misses it and
         // hits the far wall's inside.
-        let r = Ray::new(vec3(-2.0, 0.0, 1.5), vec3(1.0, 0.0, -0.5));
+        let r = Ray::new(vec3(-2.0, 0.0, 1.6), vec3(1.0, 0.0, -0.5));
         let t = c.intersect(&r).unwrap();
         assert!((r.at(t).x - 1.0).abs() < 1e-4, "{:?}", r.at(t));
     }
@@ -200,7 +200,7 @@ mod tests {
             // Nothing nearer: a shortened ray misses.
             assert!(c.intersect(&Ray { t_max: t * 0.999, ..r }).is_none() || t < 1e-3);
         }
-        assert!(hits > 1000, "{hits}");
+        assert!(hits > 500, "{hits}");
     }
 
     #[test]
