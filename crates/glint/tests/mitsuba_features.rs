@@ -435,12 +435,12 @@ fn every_unsupported_feature_is_reported() {
         &format!(
             r#"<scene version="3.0.0">
 {SENSOR}
-<shape type="cylinder"/>
+<shape type="linearcurve"/>
 <shape type="sphere">
   <bsdf type="velvet"/>
   <medium type="homogeneous" name="interior"/>
 </shape>
-<emitter type="projector"/>
+<emitter type="sunsky"/>
 <medium type="homogeneous" id="fog"/>
 <shape type="sphere"><ref name="exterior" id="fog"/></shape>
 <shape type="hair"><bsdf type="velvet"/></shape>
@@ -453,10 +453,10 @@ fn every_unsupported_feature_is_reported() {
     let e = read(&p).unwrap_err();
     let lines: Vec<&str> = e.lines().collect();
     let expect = [
-        (4, "cylinder"),
+        (4, "linearcurve"),
         (6, "velvet"),
         (7, "medium"),
-        (9, "projector"),
+        (9, "sunsky"),
         (10, "participating media"),
         (11, "medium"),
         (12, "velvet"),

@@ -165,3 +165,29 @@ fn projector_and_textured_spot_are_read() {
     let err = read(&dir, r#"<emitter type="spot"><rgb name="texture" value="0.5"/></emitter>"#).unwrap_err();
     assert!(err.contains("spatially varying"), "{err}");
 }
+
+#[test]
+fn the_json_format_describes_the_same_features() {
+    let dir = scratch("json");
+    let text = r#"{
+      "camera": { "position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 40,
+                  "projection": "orthographic", "ortho_half_width": 2 },
+      "film": { "width": 16, "height": 8, "crop": [2, 1, 8, 4] },
+      "shapes": [ { "type": "cylinder", "p0": [0, 0, -1], "p1": [0, 0, 1], "radius": 0.5 } ],
+      "lights": [
+        { "type": "projector", "position": [0, 0, 5], "target": [0, 0, 0], "fov": 30, "irradiance": [1, 1, 1] },
+        { "type": "spot", "position": [0, 0, 5], "target": [0, 0, 0], "intensity": 3,
+          "texture": { "checkerboard": [[1, 0, 0], [0, 1, 0]] } }
+      ]
+    }"#;
+    let desc = glint::formats::json::read(&dir.join("scene.json"), text).unwrap();
+    assert_eq!(desc.camera.projection, Projection::Orthographic);
+    assert_eq!(desc.film.crop, Some(CropWindow { offset_x: 2, offset_y: 1, width: 8, height: 4 }));
+    assert!(matches!(desc.shapes[0].geometry, Geometry::Cylinder { radius: 0.5, .. }));
+    assert!(matches!(desc.lights[0].light, LightKind::Projector { fov_degrees: 30.0, .. }));
+    assert!(matches!(desc.lights[1].light, LightKind::TexturedSpot { .. }));
+    let world = build(&desc, &BuildOptions::default()).unwrap();
+    // The view is 4 units wide: a ray from the crop's left edge starts 2 - 2 * 2 * 2/16 from the axis.
+    let r = world.camera().generate_ray(0.0, 2.0, [0.5; 2]);
+    assert!((r.origin.x.abs() - 1.5).abs() < 1e-4, "{:?}", r.origin);
+}

@@ -280,6 +280,22 @@ enum JsonLight {
         cutoff_angle: Option<f32>,
         #[serde(default)]
         beam_width: Option<f32>,
+        /// Projected over the cone (Mitsuba's spot `texture`); `up` turns it.
+        #[serde(default)]
+        texture: Option<JsonTexture>,
+        #[serde(default = "default_up")]
+        up: [f32; 3],
+    },
+    /// Mitsuba's `projector`.
+    Projector {
+        position: [f32; 3],
+        target: [f32; 3],
+        #[serde(default = "default_up")]
+        up: [f32; 3],
+        fov: f32,
+        irradiance: JsonTexture,
+        #[serde(default)]
+        scale: Option<f32>,
     },
     Directional {
         direction: [f32; 3],
@@ -356,6 +372,20 @@ fn transform_of(ops: &[JsonTransformOp]) -> Result<Matrix4, String> {
         t = step.then_after(&t);
     }
     Ok(t.m.0)
+}
+
+/// A light's placement: at `position`, its +z towards `target`, +y towards `up`.
+fn json_look_at(
+    ctx: &Ctx,
+    at: &str,
+    position: &[f32; 3],
+    target: &[f32; 3],
+    up: &[f32; 3],
+) -> Result<crate::describe::Matrix4, Error> {
+    let (p, t, u) = (Vec3::from_array(*position), Vec3::from_array(*target), Vec3::from_array(*up));
+    Transform::look_at(p, t, u)
+        .map(|x| x.m.0)
+        .ok_or_else(|| ctx.err(at, "the light's target equals its position, or its up is along its axis"))
 }
 
 fn texture_of(ctx: &Ctx, json_path: &str, t: &JsonTexture) -> TextureDesc {
@@ -688,7 +718,24 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             JsonLight::Point { position, intensity } => {
                 LightKind::Point { position: Vec3::from_array(*position), intensity: intensity.rgb() }
             }
-            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width } => {
+            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, texture: Some(t), up } => {
+                let cutoff = cutoff_angle.unwrap_or(20.0);
+                LightKind::TexturedSpot {
+                    to_world: json_look_at(&ctx, &at, position, target, up)?,
+                    intensity: intensity.rgb(),
+                    cutoff_degrees: cutoff,
+                    beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
+                    texture: texture_of(&ctx, &format!("{at}/texture"), t),
+                }
+            }
+            JsonLight::Projector { position, target, up, fov, irradiance, scale } => LightKind::Projector {
+                to_world: json_look_at(&ctx, &at, position, target, up)?,
+                irradiance: texture_of(&ctx, &format!("{at}/irradiance"), irradiance),
+                scale: scale.unwrap_or(1.0),
+                fov_degrees: *fov,
+                fov_axis: FovAxis::X,
+            },
+            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, .. } => {
                 let cutoff = cutoff_angle.unwrap_or(20.0);
                 LightKind::Spot {
                     position: Vec3::from_array(*position),
