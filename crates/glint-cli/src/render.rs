@@ -299,6 +299,8 @@ fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::from(format!("--width/--height: {e}")))?;
         d.film.width = w;
         d.film.height = h;
+        // A crop window is in pixels of the scene's resolution: a new one renders it all.
+        d.film.crop = None;
     }
     if let Some(spp) = a.spp {
         if spp == 0 || spp > glint::describe::limits::MAX_SPP {

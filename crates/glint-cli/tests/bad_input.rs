@@ -227,13 +227,13 @@ fn mitsuba_scene_reports_every_unsupported_feature() {
     let f = Fixture::new("mitsuba-many");
     let scene = f.write(
         "many.xml",
-        b"<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n<shape type=\"cylinder\"/>\n<shape type=\"sphere\"><bsdf type=\"velvet\"/></shape>\n<emitter type=\"projector\"/>\n</scene>\n",
+        b"<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n<shape type=\"linearcurve\"/>\n<shape type=\"sphere\"><bsdf type=\"velvet\"/></shape>\n<emitter type=\"sunsky\"/>\n</scene>\n",
     );
     let out = f.dir.join("out.png");
     let err = fails(&render_args(scene.to_str().unwrap(), out.to_str().unwrap()), &out);
     let lines: Vec<&str> = err.lines().collect();
     assert_eq!(lines.len(), 3, "{err}");
-    for (line, (n, what)) in lines.iter().zip([(3, "cylinder"), (4, "velvet"), (5, "projector")]) {
+    for (line, (n, what)) in lines.iter().zip([(3, "linearcurve"), (4, "velvet"), (5, "sunsky")]) {
         assert!(
             line.starts_with("glint: error: ") && line.contains(&format!("many.xml:{n}:")) && line.contains(what),
             "{err}"

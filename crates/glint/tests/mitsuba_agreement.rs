@@ -222,3 +222,34 @@ fn volpath_scattering_medium_in_glass() {
 fn volpath_camera_in_fog_with_rgb_extinction() {
     check_media("medium-rgb");
 }
+
+/// The cylinder: p0/p1/radius and to_world, Mitsuba's uv, one- and two-sided, flip_normals.
+#[test]
+fn cylinder_shape() {
+    check("cylinder");
+}
+
+/// shapegroup and instance: a group of a serialized mesh, a sphere and a cube drawn three
+/// times through the instances' transforms.
+#[test]
+fn shapegroup_instances() {
+    check("instance");
+}
+
+/// The orthographic sensor: a scaled to_world, a film that is not square, near and far clip.
+#[test]
+fn orthographic_sensor() {
+    check("orthographic");
+}
+
+/// A film crop window: the output is the window, with the full render's pixels there.
+#[test]
+fn film_crop_window() {
+    check("crop");
+}
+
+/// Lights that project a texture: a projector and a textured spot.
+#[test]
+fn projector_and_textured_spot() {
+    check("projector");
+}

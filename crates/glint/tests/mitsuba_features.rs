@@ -435,12 +435,12 @@ fn every_unsupported_feature_is_reported() {
         &format!(
             r#"<scene version="3.0.0">
 {SENSOR}
-<shape type="cylinder"/>
+<shape type="linearcurve"/>
 <shape type="sphere">
   <bsdf type="velvet"/>
   <medium type="heterogeneous" name="interior"/>
 </shape>
-<emitter type="projector"/>
+<emitter type="sunsky"/>
 <phase type="hg" id="p"/>
 <shape type="sphere"><medium type="homogeneous" name="inside"/></shape>
 <shape type="hair"><bsdf type="velvet"/></shape>
@@ -453,10 +453,10 @@ fn every_unsupported_feature_is_reported() {
     let e = read(&p).unwrap_err();
     let lines: Vec<&str> = e.lines().collect();
     let expect = [
-        (4, "cylinder"),
+        (4, "linearcurve"),
         (6, "velvet"),
         (7, "heterogeneous"),
-        (9, "projector"),
+        (9, "sunsky"),
         (10, "phase"),
         (11, "'interior' or 'exterior'"),
         (12, "velvet"),

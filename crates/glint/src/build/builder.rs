@@ -5,7 +5,7 @@
 use crate::accel::BvhSplit;
 use crate::camera::Camera;
 use crate::describe::Emission;
-use crate::geometry::{Sphere, TriangleMesh};
+use crate::geometry::{Cylinder, Sphere, TriangleMesh};
 use crate::io::{obj, ply, serialized};
 use crate::lights::LightSelection;
 use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
@@ -115,6 +115,7 @@ pub struct WorldBuilder {
     pub split: BvhSplit,
     meshes: Vec<Arc<TriangleMesh>>,
     spheres: Vec<Sphere>,
+    cylinders: Vec<Cylinder>,
     instances: Vec<Instance>,
     materials: Vec<Material>,
     material_names: HashMap<String, u32>,
@@ -131,6 +132,7 @@ impl WorldBuilder {
             split,
             meshes: Vec::new(),
             spheres: Vec::new(),
+            cylinders: Vec::new(),
             instances: Vec::new(),
             materials: Vec::new(),
             material_names: HashMap::new(),
@@ -306,6 +308,37 @@ impl WorldBuilder {
         Ok(())
     }
 
+    /// Places an open cylinder (Mitsuba's `p0`, `p1`, `radius`, then `to_world`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_cylinder(
+        &mut self,
+        p0: Vec3,
+        p1: Vec3,
+        radius: f32,
+        to_world: &Transform,
+        material: u32,
+        emission: Option<Emission>,
+        flip_normals: bool,
+    ) -> Result<(), String> {
+        if emission.is_some() {
+            return Err("an emitting cylinder is not supported (give the emitter to a mesh or sphere)".into());
+        }
+        let cylinder = Cylinder::new(p0, p1, radius, to_world)
+            .ok_or("a cylinder needs a positive radius, distinct end points and an invertible transform")?;
+        let id = self.cylinders.len() as u32;
+        self.cylinders.push(cylinder);
+        self.instances.push(Instance {
+            shape: ShapeRef::Cylinder(id),
+            to_world: None,
+            material,
+            light: None,
+            flip_normals,
+            bounds: cylinder.bounds(),
+            media: MediumBoundary::default(),
+        });
+        Ok(())
+    }
+
     pub fn add_light(&mut self, light: Light) {
         self.lights.push(PendingLight::Ready(light));
     }
@@ -358,6 +391,7 @@ impl WorldBuilder {
         let mut scene = World {
             meshes: self.meshes,
             spheres: self.spheres,
+            cylinders: self.cylinders,
             instances: self.instances,
             top: Default::default(),
             materials: self.materials,

@@ -151,7 +151,7 @@ pub fn build_cached(
 /// Loads the mesh files not yet cached, in parallel, each once.
 fn load_files(desc: &SceneDesc, split: BvhSplit, cache: &mut MeshCache, b: &mut WorldBuilder) -> Result<(), Error> {
     let mut files: Vec<(PathBuf, bool, u32)> =
-        desc.meshes.iter().map(|m| (m.file.clone(), m.face_normals, 0)).collect();
+        desc.meshes.iter().map(|m| (m.file.clone(), m.face_normals, m.shape_index)).collect();
     for s in &desc.shapes {
         if let Geometry::MeshFile { file, face_normals, shape_index } = &s.geometry {
             files.push((file.clone(), *face_normals, *shape_index));
@@ -206,11 +206,14 @@ fn add_shape(
             let m = desc.meshes.get(*mesh).ok_or_else(|| {
                 Error::new(format!("mesh index {mesh} is out of range ({} meshes)", desc.meshes.len()))
             })?;
-            (Source::File { file: m.file.clone(), face_normals: m.face_normals, shape_index: 0 }, true)
+            (Source::File { file: m.file.clone(), face_normals: m.face_normals, shape_index: m.shape_index }, true)
         }
         Geometry::Sphere { center, radius } => {
             check_attributes(desc, s, None)?;
             return Ok(b.add_sphere(*center, *radius, &to_world, material, s.emission, s.flip_normals)?);
+        }
+        Geometry::Cylinder { p0, p1, radius } => {
+            return Ok(b.add_cylinder(*p0, *p1, *radius, &to_world, material, s.emission, s.flip_normals)?);
         }
         g => (Source::Shape { index: place.index, geometry: geometry_hash(g) }, false),
     };

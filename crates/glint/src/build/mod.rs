@@ -20,7 +20,7 @@ use crate::describe::{
     CameraDesc, Geometry, LightKind, MaterialModel, MaterialRef, Matrix4, Roughness, SceneDesc, TextureDesc,
 };
 use crate::error::{Error, SourceLoc};
-use crate::lights::Light;
+use crate::lights::{Light, ProjectedKind, ProjectedLight};
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
 use crate::math::{Aabb, Frame, Mat4, Transform, Vec3};
 use crate::world::World;
@@ -164,6 +164,35 @@ fn add_light(b: &mut WorldBuilder, l: &LightKind, textures: &mut TextureCache) -
             let image = textures.bitmap(file, true, &SourceLoc::default())?;
             b.add_envmap((*image).clone(), *scale, transform_of(to_world)?);
         }
+        LightKind::TexturedSpot { to_world, intensity, cutoff_degrees, beam_degrees, texture } => {
+            b.add_light(Light::Projected(Arc::new(ProjectedLight {
+                to_world: transform_of(to_world)?,
+                texture: textures.texture(texture)?,
+                kind: ProjectedKind::Spot {
+                    intensity: *intensity,
+                    cutoff: cutoff_degrees.to_radians(),
+                    beam: beam_degrees.min(*cutoff_degrees).to_radians(),
+                },
+            })));
+        }
+        LightKind::Projector { to_world, irradiance, scale, fov_degrees, fov_axis } => {
+            let texture = textures.texture(irradiance)?;
+            // The field of view is taken over the texture's shape, as a camera's over its film.
+            let (w, h) = match &texture {
+                Texture::Bitmap { image, .. } => (image.width as u32, image.height as u32),
+                _ => (1, 1),
+            };
+            let lens = Camera::new(Transform::IDENTITY, w, h, *fov_degrees, *fov_axis);
+            b.add_light(Light::Projected(Arc::new(ProjectedLight {
+                to_world: transform_of(to_world)?,
+                texture,
+                kind: ProjectedKind::Projector {
+                    scale: *scale,
+                    tan_half_x: lens.tan_half_x,
+                    aspect: w as f32 / h as f32,
+                },
+            })));
+        }
     }
     Ok(())
 }
@@ -179,6 +208,10 @@ fn camera(desc: &SceneDesc, bounds: &Aabb) -> Result<Camera, Error> {
     camera.focus_distance = c.focus_distance;
     camera.near_clip = c.near_clip;
     camera.far_clip = c.far_clip;
+    camera.projection = c.projection;
+    if let Some(crop) = desc.film.crop {
+        camera.set_crop(crop);
+    }
     Ok(camera)
 }
 

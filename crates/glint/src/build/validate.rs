@@ -73,6 +73,16 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
                     return Err(Error::at(&s.loc, format!("sphere radius {radius} must be positive and finite")));
                 }
             }
+            Geometry::Cylinder { p0, p1, radius } => {
+                vector(*p0, "cylinder p0").map_err(|m| Error::at(&s.loc, m))?;
+                vector(*p1, "cylinder p1").map_err(|m| Error::at(&s.loc, m))?;
+                if !(*radius > 0.0 && radius.is_finite()) {
+                    return Err(Error::at(&s.loc, format!("cylinder radius {radius} must be positive and finite")));
+                }
+                if !((*p1 - *p0).length() > 0.0) {
+                    return Err(Error::at(&s.loc, "cylinder: p0 and p1 must differ"));
+                }
+            }
             Geometry::Mesh(m) => {
                 if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
                     return Err(Error::at(&s.loc, format!("mesh vertex {i} is not finite")));
@@ -89,6 +99,18 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
 
 fn film(f: &FilmDesc) -> Result<(), Error> {
     check_resolution(f.width, f.height).map_err(|e| Error::at(&f.loc, e))?;
+    if let Some(c) = &f.crop {
+        let fits = |offset: u32, size: u32, full: u32| size >= 1 && offset as u64 + size as u64 <= full as u64;
+        if !fits(c.offset_x, c.width, f.width) || !fits(c.offset_y, c.height, f.height) {
+            return Err(Error::at(
+                &f.loc,
+                format!(
+                    "the crop window ({}x{} at {}, {}) must be at least one pixel and lie within the {}x{} film",
+                    c.width, c.height, c.offset_x, c.offset_y, f.width, f.height
+                ),
+            ));
+        }
+    }
     let ok = match f.filter {
         PixelFilter::Box => true,
         PixelFilter::Tent { radius } => radius > 0.0 && radius.is_finite() && radius <= 64.0,
@@ -228,6 +250,28 @@ fn light(l: &LightKind) -> Result<(), String> {
                 return Err(format!("envmap scale {scale} must be finite and at least 0"));
             }
             matrix(to_world, "to_world")
+        }
+        LightKind::TexturedSpot { to_world, intensity, cutoff_degrees, beam_degrees, .. } => {
+            matrix(to_world, "to_world")?;
+            color(*intensity, "intensity")?;
+            // Below 90 degrees: the texture is laid over tan(cutoff).
+            if !(*cutoff_degrees > 0.0 && *cutoff_degrees < 90.0) {
+                return Err(format!("textured spot cutoff angle {cutoff_degrees} is out of range (0, 90) degrees"));
+            }
+            if !(*beam_degrees >= 0.0 && beam_degrees.is_finite()) {
+                return Err(format!("spot beam width {beam_degrees} must be finite and at least 0"));
+            }
+            Ok(())
+        }
+        LightKind::Projector { to_world, scale, fov_degrees, .. } => {
+            matrix(to_world, "to_world")?;
+            if !(*scale >= 0.0 && scale.is_finite()) {
+                return Err(format!("projector scale {scale} must be finite and at least 0"));
+            }
+            if !(*fov_degrees > 0.0 && *fov_degrees < 180.0) {
+                return Err(format!("projector fov {fov_degrees} is out of range (0, 180) degrees"));
+            }
+            Ok(())
         }
     }
 }

@@ -9,7 +9,7 @@
 //! it, made before the build.
 
 use crate::bsdf::MicrofacetKind;
-use crate::camera::FovAxis;
+use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::error::SourceLoc;
 use crate::lights::LightSelection;
 use crate::math::{Rgb, Vec3};
@@ -68,6 +68,9 @@ pub struct CameraDesc {
     /// The medium the camera sits in (index into [`SceneDesc::media`]); `None` is vacuum.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub medium: Option<usize>,
+    /// Perspective (the field of view and lens above) or orthographic (they are unused).
+    #[serde(default)]
+    pub projection: Projection,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -76,6 +79,9 @@ pub struct FilmDesc {
     pub height: u32,
     pub filter: PixelFilter,
     pub loc: SourceLoc,
+    /// Render only this part of the `width` x `height` image (Mitsuba's crop window).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crop: Option<CropWindow>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -211,6 +217,9 @@ pub struct MeshFileDesc {
     pub file: PathBuf,
     pub face_normals: bool,
     pub loc: SourceLoc,
+    /// Which mesh of a `.serialized` file (Mitsuba's `shape_index`); 0 for other files.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub shape_index: u32,
 }
 
 /// Which material a shape uses.
@@ -290,6 +299,13 @@ pub enum Geometry {
     Cube,
     /// The unit disk in the z = 0 plane, facing +z.
     Disk,
+    /// An open tube (no end caps) of `radius` around the segment `p0` to `p1`, its normals
+    /// outward (Mitsuba's `cylinder`).
+    Cylinder {
+        p0: Vec3,
+        p1: Vec3,
+        radius: f32,
+    },
 }
 
 fn is_zero(v: &u32) -> bool {
@@ -339,6 +355,24 @@ pub enum LightKind {
         file: PathBuf,
         scale: f32,
         to_world: Matrix4,
+    },
+    /// A spot light projecting a texture (Mitsuba's `spot` with `texture`), at the origin
+    /// of `to_world` looking along its +z; its rotation about that axis turns the texture.
+    TexturedSpot {
+        to_world: Matrix4,
+        intensity: Rgb,
+        cutoff_degrees: f32,
+        beam_degrees: f32,
+        texture: TextureDesc,
+    },
+    /// Mitsuba's `projector`: a pinhole projecting `irradiance` with the field of view of
+    /// a camera whose film has the texture's aspect ratio.
+    Projector {
+        to_world: Matrix4,
+        irradiance: TextureDesc,
+        scale: f32,
+        fov_degrees: f32,
+        fov_axis: FovAxis,
     },
 }
 
@@ -400,8 +434,11 @@ impl SceneDesc {
             }
         }
         for l in &self.lights {
-            if let LightKind::EnvMap { file, .. } = &l.light {
-                add(file);
+            match &l.light {
+                LightKind::EnvMap { file, .. } => add(file),
+                LightKind::TexturedSpot { texture: TextureDesc::Bitmap { file, .. }, .. }
+                | LightKind::Projector { irradiance: TextureDesc::Bitmap { file, .. }, .. } => add(file),
+                _ => {}
             }
         }
         out
@@ -506,6 +543,7 @@ impl Default for CameraDesc {
             far_clip: f32::MAX,
             loc: SourceLoc::default(),
             medium: None,
+            projection: Projection::Perspective,
         }
     }
 }
@@ -518,7 +556,7 @@ mod tests {
     fn round_trips_through_json() {
         let mut d = SceneDesc::empty(
             CameraDesc::default(),
-            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default() },
+            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None },
         );
         d.shapes.push(ShapeDesc {
             geometry: Geometry::Sphere { center: Vec3::ZERO, radius: 1.0 },
@@ -538,7 +576,7 @@ mod tests {
     fn desc_with_files() -> SceneDesc {
         let mut d = SceneDesc::empty(
             CameraDesc::default(),
-            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default() },
+            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None },
         );
         d.source = Some("scene.xml".into());
         d.includes.push("part.xml".into());
@@ -560,6 +598,7 @@ mod tests {
             file: "bunny.ply".into(),
             face_normals: false,
             loc: SourceLoc::default(),
+            shape_index: 0,
         });
         for file in ["box.obj", "bunny.ply"] {
             d.shapes.push(ShapeDesc {

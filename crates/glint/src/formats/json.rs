@@ -6,7 +6,7 @@
 
 use super::json_spans::Spans;
 use crate::bsdf::MicrofacetKind;
-use crate::camera::FovAxis;
+use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
     CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
     MaterialModel, MaterialRef, Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc,
@@ -75,6 +75,12 @@ struct JsonCamera {
     focus_distance: Option<f32>,
     #[serde(default)]
     medium: Option<String>,
+    /// `perspective` (default) or `orthographic`.
+    #[serde(default)]
+    projection: Option<String>,
+    /// Orthographic: half the width of the view, in scene units (default 1).
+    #[serde(default)]
+    ortho_half_width: Option<f32>,
 }
 
 fn default_up() -> [f32; 3] {
@@ -88,6 +94,9 @@ struct JsonFilm {
     height: u64,
     #[serde(default)]
     filter: Option<String>,
+    /// Render only [offset_x, offset_y, width, height] of the image.
+    #[serde(default)]
+    crop: Option<[u64; 4]>,
 }
 
 #[derive(Deserialize)]
@@ -294,6 +303,9 @@ struct JsonShape {
     interior: Option<String>,
     #[serde(default)]
     exterior: Option<String>,
+    p0: Option<[f32; 3]>,
+    #[serde(default)]
+    p1: Option<[f32; 3]>,
 }
 
 #[derive(Deserialize)]
@@ -321,6 +333,22 @@ enum JsonLight {
         cutoff_angle: Option<f32>,
         #[serde(default)]
         beam_width: Option<f32>,
+        /// Projected over the cone (Mitsuba's spot `texture`); `up` turns it.
+        #[serde(default)]
+        texture: Option<JsonTexture>,
+        #[serde(default = "default_up")]
+        up: [f32; 3],
+    },
+    /// Mitsuba's `projector`.
+    Projector {
+        position: [f32; 3],
+        target: [f32; 3],
+        #[serde(default = "default_up")]
+        up: [f32; 3],
+        fov: f32,
+        irradiance: JsonTexture,
+        #[serde(default)]
+        scale: Option<f32>,
     },
     Directional {
         direction: [f32; 3],
@@ -397,6 +425,20 @@ fn transform_of(ops: &[JsonTransformOp]) -> Result<Matrix4, String> {
         t = step.then_after(&t);
     }
     Ok(t.m.0)
+}
+
+/// A light's placement: at `position`, its +z towards `target`, +y towards `up`.
+fn json_look_at(
+    ctx: &Ctx,
+    at: &str,
+    position: &[f32; 3],
+    target: &[f32; 3],
+    up: &[f32; 3],
+) -> Result<crate::describe::Matrix4, Error> {
+    let (p, t, u) = (Vec3::from_array(*position), Vec3::from_array(*target), Vec3::from_array(*up));
+    Transform::look_at(p, t, u)
+        .map(|x| x.m.0)
+        .ok_or_else(|| ctx.err(at, "the light's target equals its position, or its up is along its axis"))
 }
 
 fn texture_of(ctx: &Ctx, json_path: &str, t: &JsonTexture) -> TextureDesc {
@@ -571,6 +613,25 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         Some(f) => f,
         None => (Vec3::from_array(cam.look_at) - Vec3::from_array(cam.position)).length(),
     };
+    let projection = match cam.projection.as_deref() {
+        None | Some("perspective") => Projection::Perspective,
+        Some("orthographic") => Projection::Orthographic,
+        Some(other) => {
+            return Err(
+                ctx.err("camera/projection", format!("unknown projection '{other}' (perspective, orthographic)"))
+            )
+        }
+    };
+    let to_world = match (projection, cam.ortho_half_width) {
+        (Projection::Orthographic, Some(s)) => {
+            let scale = Transform::scale(Vec3 { x: s, y: s, z: 1.0 }).filter(|_| s > 0.0 && s.is_finite());
+            let scale = scale.ok_or_else(|| {
+                ctx.err("camera/ortho_half_width", format!("ortho_half_width {s} must be positive and finite"))
+            })?;
+            to_world.then_after(&scale)
+        }
+        _ => to_world,
+    };
     let camera = CameraDesc {
         to_world: Some(to_world.m.0),
         fov_degrees: cam.fov,
@@ -581,6 +642,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         far_clip: f32::MAX,
         loc: ctx.loc("camera"),
         medium: None,
+        projection,
     };
     let filter = match file.film.filter.as_deref() {
         None | Some("box") => PixelFilter::Box,
@@ -590,7 +652,16 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
     };
     let (width, height) = (file.film.width.min(u32::MAX as u64) as u32, file.film.height.min(u32::MAX as u64) as u32);
     crate::describe::limits::check_resolution(width, height).map_err(|e| ctx.err("film", e))?;
-    let film = FilmDesc { width, height, filter, loc: ctx.loc("film") };
+    let film = FilmDesc {
+        width,
+        height,
+        filter,
+        loc: ctx.loc("film"),
+        crop: file.film.crop.map(|[x, y, w, h]| {
+            let n = |v: u64| v.min(u32::MAX as u64) as u32;
+            CropWindow { offset_x: n(x), offset_y: n(y), width: n(w), height: n(h) }
+        }),
+    };
     let mut desc = SceneDesc::empty(camera, film);
     desc.source = Some(path.to_path_buf());
 
@@ -711,6 +782,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             file: ctx.resolve(&m.file),
             face_normals: m.face_normals,
             loc: ctx.loc(&format!("meshes/{name}")),
+            shape_index: 0,
         });
     }
 
@@ -748,11 +820,16 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             "rectangle" => Geometry::Rectangle,
             "cube" => Geometry::Cube,
             "disk" => Geometry::Disk,
+            "cylinder" => Geometry::Cylinder {
+                p0: Vec3::from_array(s.p0.unwrap_or([0.0; 3])),
+                p1: Vec3::from_array(s.p1.unwrap_or([0.0, 0.0, 1.0])),
+                radius: s.radius.unwrap_or(1.0),
+            },
             other => {
                 return Err(ctx.err(
                     &format!("{at}/type"),
                     format!(
-                        "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk)"
+                        "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk, cylinder)"
                     ),
                 ))
             }
@@ -779,7 +856,24 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             JsonLight::Point { position, intensity } => {
                 LightKind::Point { position: Vec3::from_array(*position), intensity: intensity.rgb() }
             }
-            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width } => {
+            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, texture: Some(t), up } => {
+                let cutoff = cutoff_angle.unwrap_or(20.0);
+                LightKind::TexturedSpot {
+                    to_world: json_look_at(&ctx, &at, position, target, up)?,
+                    intensity: intensity.rgb(),
+                    cutoff_degrees: cutoff,
+                    beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
+                    texture: texture_of(&ctx, &format!("{at}/texture"), t),
+                }
+            }
+            JsonLight::Projector { position, target, up, fov, irradiance, scale } => LightKind::Projector {
+                to_world: json_look_at(&ctx, &at, position, target, up)?,
+                irradiance: texture_of(&ctx, &format!("{at}/irradiance"), irradiance),
+                scale: scale.unwrap_or(1.0),
+                fov_degrees: *fov,
+                fov_axis: FovAxis::X,
+            },
+            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, .. } => {
                 let cutoff = cutoff_angle.unwrap_or(20.0);
                 LightKind::Spot {
                     position: Vec3::from_array(*position),

@@ -83,6 +83,13 @@ pub fn closest_hit_cost(scene: &World, ray: &Ray) -> u64 {
                     }
                     None => false,
                 },
+                ShapeRef::Cylinder(c) => match scene.cylinders[c as usize].intersect(r) {
+                    Some(t) => {
+                        r.t_max = t;
+                        true
+                    }
+                    None => false,
+                },
             }
         });
     }

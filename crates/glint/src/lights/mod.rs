@@ -9,10 +9,12 @@
 //! hit by BSDF-sampled rays.
 
 mod envmap;
+mod projected;
 mod rectangle;
 mod selection;
 mod sphere;
 pub use envmap::EnvMap;
+pub use projected::{ProjectedKind, ProjectedLight};
 pub use rectangle::Rectangle;
 pub use selection::LightSelection;
 
@@ -112,11 +114,13 @@ pub enum Light {
     },
     /// Environment map, importance-sampled by luminance.
     EnvMap(Arc<EnvMap>),
+    /// A point light projecting a texture (a textured spot, or a projector).
+    Projected(Arc<ProjectedLight>),
 }
 
 impl Light {
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. })
+        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } | Light::Projected(_))
     }
 
     pub fn is_infinite(&self) -> bool {
@@ -153,6 +157,7 @@ impl Light {
                 4.0 * PI * PI * scene_radius * scene_radius * radiance.luminance()
             }
             Light::EnvMap(env) => 4.0 * PI * PI * env.scene_radius * env.scene_radius * env.mean_luminance(),
+            Light::Projected(l) => l.power(),
         }
     }
 
@@ -221,6 +226,7 @@ impl Light {
                 })
             }
             Light::EnvMap(env) => env.sample(u),
+            Light::Projected(l) => l.sample_li(p),
         }
     }
 

@@ -148,6 +148,8 @@ fn light_slots(l: &mut LightKind) -> Vec<(&'static str, Slot<'_>)> {
         LightKind::Directional { irradiance, .. } => vec![("irradiance", Slot::Color(irradiance))],
         LightKind::Constant { radiance } => vec![("radiance", Slot::Color(radiance))],
         LightKind::EnvMap { scale, .. } => vec![("scale", Slot::Float(scale))],
+        LightKind::TexturedSpot { intensity, .. } => vec![("intensity", Slot::Color(intensity))],
+        LightKind::Projector { scale, .. } => vec![("scale", Slot::Float(scale))],
     }
 }
 

@@ -9,7 +9,7 @@
 
 use crate::accel::{BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
-use crate::geometry::{Sphere, TriangleMesh};
+use crate::geometry::{Cylinder, Sphere, TriangleMesh};
 use crate::lights::{Light, LightSelection};
 use crate::materials::Material;
 use crate::math::{Aabb, Frame, Ray, Transform, Vec3};
@@ -21,6 +21,7 @@ use std::sync::Arc;
 pub enum ShapeRef {
     Mesh(u32),
     Sphere(u32),
+    Cylinder(u32),
 }
 
 #[derive(Clone, Debug)]
@@ -75,6 +76,7 @@ pub struct SurfaceInteraction {
 pub struct World {
     pub(crate) meshes: Vec<Arc<TriangleMesh>>,
     pub(crate) spheres: Vec<Sphere>,
+    pub(crate) cylinders: Vec<Cylinder>,
     pub(crate) instances: Vec<Instance>,
     /// Over instances: the binary reference and the 8-wide tree that traversal uses.
     pub(crate) top: TopLevelBvh,
@@ -188,6 +190,9 @@ impl World {
             ShapeRef::Sphere(s) => {
                 self.spheres[s as usize].intersect(r).map(|t| Hit { t, instance: 0, prim: 0, b1: 0.0, b2: 0.0 })
             }
+            ShapeRef::Cylinder(c) => {
+                self.cylinders[c as usize].intersect(r).map(|t| Hit { t, instance: 0, prim: 0, b1: 0.0, b2: 0.0 })
+            }
         }
     }
 
@@ -210,6 +215,7 @@ impl World {
                     }
                 }
                 ShapeRef::Sphere(s) => self.spheres[s as usize].intersect(r).is_some(),
+                ShapeRef::Cylinder(c) => self.cylinders[c as usize].intersect(r).is_some(),
             }
         })
     }
@@ -234,6 +240,13 @@ impl World {
                     })
                 }
                 ShapeRef::Sphere(s) => self.spheres[s as usize].intersect(&r).map(|t| Hit {
+                    t,
+                    instance: i as u32,
+                    prim: 0,
+                    b1: 0.0,
+                    b2: 0.0,
+                }),
+                ShapeRef::Cylinder(c) => self.cylinders[c as usize].intersect(&r).map(|t| Hit {
                     t,
                     instance: i as u32,
                     prim: 0,
@@ -304,6 +317,10 @@ impl World {
                 let (dpdu, dpdv) = (sph.to_world(dpdu), sph.to_world(dpdv));
                 (p, n, None, [phi / (2.0 * std::f32::consts::PI), theta / std::f32::consts::PI], dpdu, dpdv)
             }
+            ShapeRef::Cylinder(c) => {
+                let q = self.cylinders[c as usize].point(ray, hit.t);
+                (q.p, q.n, None, q.uv, q.dpdu, q.dpdv)
+            }
         };
         ng = ng.normalize();
         if inst.flip_normals {
@@ -348,6 +365,9 @@ impl World {
     pub fn spheres(&self) -> &[Sphere] {
         &self.spheres
     }
+    pub fn cylinders(&self) -> &[Cylinder] {
+        &self.cylinders
+    }
     pub fn instances(&self) -> &[Instance] {
         &self.instances
     }
@@ -385,7 +405,7 @@ impl World {
             .iter()
             .map(|i| match i.shape {
                 ShapeRef::Mesh(m) => self.meshes[m as usize].indices.len(),
-                ShapeRef::Sphere(_) => 0,
+                ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) => 0,
             })
             .sum()
     }

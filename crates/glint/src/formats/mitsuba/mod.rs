@@ -4,7 +4,9 @@
 //! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
 //! an error that names the plugin, the file and the line.
 
+mod instances;
 mod media;
+mod projected;
 mod props;
 mod spectrum;
 mod surface;
@@ -12,7 +14,7 @@ pub mod xml;
 
 use super::Define;
 use crate::bsdf::MicrofacetKind;
-use crate::camera::FovAxis;
+use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
     CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
     MaterialRef, MediumDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, ShapeMedia, TextureDesc,
@@ -66,6 +68,8 @@ struct Reader<'a> {
     materials: Vec<MaterialDesc>,
     shapes: Vec<ShapeDesc>,
     lights: Vec<LightDesc>,
+    /// Mesh files placed by `instance`s of shape groups, each loaded once.
+    meshes: Vec<crate::describe::MeshFileDesc>,
     warnings: Vec<String>,
     /// Errors found so far: a scene's unsupported features are all reported, one a line.
     errors: Vec<Error>,
@@ -115,6 +119,7 @@ fn describe_tree<'a>(
         materials: Vec::new(),
         shapes: Vec::new(),
         lights: Vec::new(),
+        meshes: Vec::new(),
         warnings: tree.warnings.clone(),
         errors: Vec::new(),
         medium_index: HashMap::new(),
@@ -169,6 +174,7 @@ fn describe_tree<'a>(
     desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp, seed };
     desc.materials = r.materials;
     desc.shapes = r.shapes;
+    desc.meshes = r.meshes;
     desc.lights = r.lights;
     if !desc.media.is_empty() || !r.media.is_empty() {
         if !matches!(desc.integrator, IntegratorDesc::Volpath(_)) {
@@ -246,6 +252,21 @@ fn settings_spp(sampler: Option<&Element>) -> Result<Option<u32>, Error> {
         return Ok(Some(n as u32));
     }
     Ok(None)
+}
+
+/// `hdrfilm`'s crop window (`crop_offset_x/y`, default 0; `crop_width/height`, default the
+/// rest of the film), checked as Mitsuba checks it; `None` when it is the whole film.
+fn film_crop(fp: &Props, width: u32, height: u32) -> Result<Option<CropWindow>, Error> {
+    let (ox, oy) = (fp.int("crop_offset_x", 0)?, fp.int("crop_offset_y", 0)?);
+    let (cw, ch) = (fp.int("crop_width", width as i64 - ox)?, fp.int("crop_height", height as i64 - oy)?);
+    let fits = |o: i64, s: i64, full: u32| o >= 0 && s >= 1 && o + s <= full as i64;
+    if !fits(ox, cw, width) || !fits(oy, ch, height) {
+        return Err(fp.el.err(format!(
+            "the crop window ({cw}x{ch} at {ox}, {oy}) must be at least one pixel and lie within the {width}x{height} film"
+        )));
+    }
+    let crop = CropWindow { offset_x: ox as u32, offset_y: oy as u32, width: cw as u32, height: ch as u32 };
+    Ok((crop != CropWindow { offset_x: 0, offset_y: 0, width, height }).then_some(crop))
 }
 
 fn matrix(t: &Transform) -> crate::describe::Matrix4 {
@@ -440,9 +461,22 @@ impl<'a> Reader<'a> {
     }
 
     fn shape(&mut self, el: &'a Element) -> Result<(), Error> {
+        match el.attr("type").unwrap_or("") {
+            "shapegroup" => self.shape_group(el),
+            "instance" => self.instance(el),
+            _ => self.placed_shape(el, None),
+        }
+    }
+
+    /// A shape, placed by its `to_world` and then (inside a shape group) by the instance's.
+    fn placed_shape(&mut self, el: &'a Element, instance_to_world: Option<&Transform>) -> Result<(), Error> {
         let p = Props::new(el);
         let ty = el.attr("type").unwrap_or("");
-        let to_world = p.transform("to_world")?;
+        let own_to_world = p.transform("to_world")?;
+        let to_world = match instance_to_world {
+            Some(t) => t.then_after(&own_to_world),
+            None => own_to_world,
+        };
         let flip_normals = p.bool("flip_normals", false)?;
         // BSDF: a nested <bsdf> or a <ref> to one.
         let mut material = None;
@@ -467,6 +501,11 @@ impl<'a> Reader<'a> {
             };
             self.note(result);
         }
+        if ty == "cylinder" && emission.is_some() {
+            self.note::<()>(
+                Err(el.err("an emitting cylinder is not supported (give the emitter to a mesh or sphere)")),
+            );
+        }
         // Mitsuba gives a shape without a BSDF a diffuse 0.5 one, and an emitting shape a
         // black one (its light does not reflect light).
         let material = match (material, &emission) {
@@ -480,6 +519,11 @@ impl<'a> Reader<'a> {
                 let path = self.resolve_file(el, file);
                 Geometry::MeshFile { file: path, face_normals: p.bool("face_normals", false)?, shape_index: 0 }
             }
+            "cylinder" => Geometry::Cylinder {
+                p0: p.point("p0")?.unwrap_or(Vec3::ZERO),
+                p1: p.point("p1")?.unwrap_or(Vec3::Z),
+                radius: p.float("radius", 1.0)?,
+            },
             "serialized" => {
                 let file = p.string("filename").ok_or_else(|| el.err("shape 'serialized' needs 'filename'"))?;
                 let path = self.resolve_file(el, file);
@@ -510,6 +554,14 @@ impl<'a> Reader<'a> {
         if self.errors.len() > errors_before {
             return Ok(());
         }
+        // Meshes of a shape group are loaded once and traced through each instance's
+        // transform (as Mitsuba shares a group's BVH among its instances).
+        let geometry = match (instance_to_world, geometry) {
+            (Some(_), Geometry::MeshFile { file, face_normals, shape_index }) => {
+                Geometry::Instance { mesh: self.shared_mesh(el, file, face_normals, shape_index) }
+            }
+            (_, g) => g,
+        };
         self.shapes.push(ShapeDesc {
             geometry,
             to_world: matrix(&to_world),
@@ -531,6 +583,9 @@ impl<'a> Reader<'a> {
             )));
         }
         let ep = Props::new(c);
+        if ep.find("radiance").and_then(|e| self.resolve(e).ok()).is_some_and(|e| e.tag == "texture") {
+            return Err(c.err("area: a textured 'radiance' is not supported (give a colour)"));
+        }
         let emission =
             Emission { radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?, two_sided: false };
         self.warn_unused(&ep);
@@ -548,10 +603,9 @@ impl<'a> Reader<'a> {
                 },
                 intensity: p.rgb_as("intensity", Rgb::WHITE, SpectrumUse::Emission)?,
             },
+            "spot" if p.find("texture").is_some() => self.textured_spot(&p, &to_world)?,
+            "projector" => self.projector(&p, &to_world)?,
             "spot" => {
-                if p.find("texture").is_some() {
-                    return Err(el.err("spot: projected textures are not supported"));
-                }
                 let cutoff = p.float("cutoff_angle", 20.0)?;
                 LightKind::Spot {
                     position: to_world.point(Vec3::ZERO),
@@ -609,12 +663,15 @@ impl<'a> Reader<'a> {
         sampler_el: Option<&'a Element>,
     ) -> Result<(CameraDesc, FilmDesc, u64), Error> {
         let ty = el.attr("type").unwrap_or("");
-        if ty != "perspective" && ty != "thinlens" {
-            return Err(el.err(format!("sensor plugin '{ty}' is not supported (perspective, thinlens)")));
+        if !matches!(ty, "perspective" | "thinlens" | "orthographic") {
+            return Err(el.err(format!("sensor plugin '{ty}' is not supported (perspective, thinlens, orthographic)")));
         }
         let p = Props::new(el);
         let to_world = p.transform("to_world")?;
-        let fov = match (p.opt_float("fov")?, p.string("focal_length")) {
+        let orthographic = ty == "orthographic";
+        // An orthographic camera has no field of view (its fov is an unused placeholder).
+        let fov_given = if orthographic { (Some(45.0), None) } else { (p.opt_float("fov")?, p.string("focal_length")) };
+        let fov = match fov_given {
             (Some(f), _) => f,
             (None, Some(fl)) => {
                 let mm: f32 =
@@ -624,13 +681,19 @@ impl<'a> Reader<'a> {
             }
             (None, None) => 2.0 * (43.266_615f32 / (2.0 * 50.0)).atan().to_degrees(),
         };
-        let fov_axis: FovAxis = match p.string("fov_axis") {
-            Some(a) => a.parse().map_err(|e: String| el.err(e))?,
-            None if p.opt_float("fov")?.is_some() => FovAxis::X,
-            None => FovAxis::Diagonal,
+        let fov_axis: FovAxis = match (orthographic, p.string("fov_axis")) {
+            (true, _) => FovAxis::X,
+            (false, Some(a)) => a.parse().map_err(|e: String| el.err(e))?,
+            (false, None) if p.opt_float("fov")?.is_some() => FovAxis::X,
+            (false, None) => FovAxis::Diagonal,
         };
-        let mut film =
-            FilmDesc { width: 768, height: 576, filter: PixelFilter::Gaussian { stddev: 0.5 }, loc: el.loc() };
+        let mut film = FilmDesc {
+            width: 768,
+            height: 576,
+            filter: PixelFilter::Gaussian { stddev: 0.5 },
+            loc: el.loc(),
+            crop: None,
+        };
         if let Some(f) = film_el {
             if f.attr("type") != Some("hdrfilm") {
                 return Err(f.err(format!("film plugin '{}' is not supported (hdrfilm)", f.attr("type").unwrap_or(""))));
@@ -660,9 +723,7 @@ impl<'a> Reader<'a> {
                     other => return Err(rf.err(format!("rfilter '{other}' is not supported (box, tent, gaussian)"))),
                 };
             }
-            if fp.find("crop_width").is_some() || fp.find("crop_offset_x").is_some() {
-                return Err(f.err("film cropping is not supported"));
-            }
+            film.crop = film_crop(&fp, film.width, film.height)?;
             self.warn_unused(&fp);
         }
         let mut camera = CameraDesc {
@@ -675,6 +736,7 @@ impl<'a> Reader<'a> {
             far_clip: p.float("far_clip", 1e4)?,
             loc: el.loc(),
             medium: self.sensor_medium(el)?,
+            projection: if orthographic { Projection::Orthographic } else { Projection::Perspective },
         };
         // Perspective cameras accept (and, like Mitsuba, ignore) a focus distance.
         let _ = p.opt_float("focus_distance")?;

@@ -1,0 +1,193 @@
+//! Mitsuba's cylinder, shapegroup/instance, orthographic sensor, crop windows and projected
+//! lights: what the reader makes of them, and the built world's geometry.
+
+use glint::build::{build, BuildOptions};
+use glint::camera::{CropWindow, Projection};
+use glint::describe::{Geometry, LightKind, SceneDesc};
+use glint::formats::mitsuba::read_str;
+use glint::math::{vec3, Ray, Vec3};
+use std::path::{Path, PathBuf};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("glint-mitsuba-shapes-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn read(dir: &Path, body: &str) -> Result<SceneDesc, String> {
+    let text = format!(
+        r#"<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="6"/></film></sensor>
+  {body}
+</scene>"#
+    );
+    read_str(&text, &dir.join("scene.xml"), &[]).map_err(|e| e.to_string())
+}
+
+const TRIANGLE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+#[test]
+fn instances_share_the_group_meshes_and_compose_transforms() {
+    let dir = scratch("instances");
+    std::fs::write(dir.join("tri.obj"), TRIANGLE).unwrap();
+    let desc = read(
+        &dir,
+        r#"<shape type="shapegroup" id="g">
+             <shape type="obj"><string name="filename" value="tri.obj"/>
+               <transform name="to_world"><translate x="1"/></transform></shape>
+             <shape type="sphere"><float name="radius" value="0.5"/></shape>
+           </shape>
+           <shape type="instance"><ref id="g"/></shape>
+           <shape type="instance"><ref id="g"/>
+             <transform name="to_world"><scale value="2"/><translate z="5"/></transform></shape>"#,
+    )
+    .unwrap();
+    // The group itself draws nothing; each instance draws both shapes.
+    assert_eq!(desc.shapes.len(), 4);
+    assert_eq!(desc.meshes.len(), 1, "the mesh file is described once");
+    assert!(matches!(desc.shapes[0].geometry, Geometry::Instance { mesh: 0 }));
+    assert!(matches!(desc.shapes[2].geometry, Geometry::Instance { mesh: 0 }));
+    // The second instance: the mesh's own translate, then the instance's scale and translate.
+    let m = desc.shapes[2].to_world;
+    assert_eq!([m[0][3], m[1][3], m[2][3]], [2.0, 0.0, 5.0]);
+    assert_eq!(m[0][0], 2.0);
+    let world = build(&desc, &BuildOptions::default()).unwrap();
+    assert_eq!(world.meshes().len(), 1, "one BVH for the mesh, placed twice");
+    // A ray down onto the second instance's triangle (x in [2, 4], at z = 5).
+    let hit = world.intersect(&Ray::new(vec3(2.5, 0.5, 10.0), vec3(0.0, 0.0, -1.0))).unwrap();
+    assert!((hit.t - 5.0).abs() < 1e-4, "{}", hit.t);
+    // And the second sphere (radius 1 at z = 5) from the side.
+    let hit = world.intersect(&Ray::new(vec3(-5.0, 0.0, 5.0), Vec3::X)).unwrap();
+    assert!((hit.t - 4.0).abs() < 1e-4, "{}", hit.t);
+}
+
+#[test]
+fn every_unsupported_instancing_feature_is_reported_in_one_run() {
+    let dir = scratch("instance-errors");
+    let err = read(
+        &dir,
+        r#"<shape type="shapegroup" id="g">
+             <shape type="sphere"><emitter type="area"/></shape>
+             <shape type="shapegroup" id="inner"/>
+           </shape>
+           <shape type="instance"><ref id="g"/><transform name="to_world"><scale x="-1"/></transform></shape>
+           <shape type="instance"/>
+           <shape type="instance"><ref id="g"/><bsdf type="diffuse"/></shape>
+           <shape type="shapegroup"/>"#,
+    )
+    .unwrap_err();
+    for needle in [
+        "cannot emit light",
+        "cannot hold another shapegroup",
+        "mirrors",
+        "exactly one <ref id>",
+        "an instance takes no <bsdf>",
+        "a shapegroup needs an id",
+    ] {
+        assert!(err.contains(needle), "missing '{needle}' in:\n{err}");
+    }
+    assert!(err.lines().all(|l| l.contains("scene.xml:")), "{err}");
+}
+
+#[test]
+fn cylinder_is_read_with_mitsubas_defaults_and_hit_in_the_world() {
+    let dir = scratch("cylinder");
+    let desc = read(
+        &dir,
+        r#"<shape type="cylinder"><float name="radius" value="0.5"/>
+             <point name="p1" x="0" y="0" z="2"/></shape>"#,
+    )
+    .unwrap();
+    let Geometry::Cylinder { p0, p1, radius } = desc.shapes[0].geometry else { panic!() };
+    assert_eq!((p0, p1, radius), (Vec3::ZERO, vec3(0.0, 0.0, 2.0), 0.5));
+    let world = build(&desc, &BuildOptions::default()).unwrap();
+    let ray = Ray::new(vec3(3.0, 0.0, 1.5), vec3(-1.0, 0.0, 0.0));
+    let hit = world.intersect(&ray).unwrap();
+    assert!((hit.t - 2.5).abs() < 1e-5);
+    let si = world.interaction(&ray, &hit);
+    assert!((si.ng - Vec3::X).length() < 1e-5);
+    assert!((si.uv[0] - 0.0).abs() < 1e-5 && (si.uv[1] - 0.75).abs() < 1e-5);
+    assert!(world.occluded(&Ray::segment(vec3(3.0, 0.0, 1.5), vec3(-1.0, 0.0, 0.0), 10.0)));
+    // Above the open tube: nothing.
+    assert!(world.intersect(&Ray::new(vec3(3.0, 0.0, 2.5), vec3(-1.0, 0.0, 0.0))).is_none());
+    // A zero radius and an emitting cylinder are one-line errors.
+    let err = read(&dir, r#"<shape type="cylinder"><float name="radius" value="0"/></shape>"#)
+        .and_then(|d| build(&d, &BuildOptions::default()).map(|_| ()).map_err(|e| e.to_string()))
+        .unwrap_err();
+    assert!(err.contains("radius") && err.contains("scene.xml:"), "{err}");
+    let err = read(&dir, r#"<shape type="cylinder"><emitter type="area"/></shape>"#).unwrap_err();
+    assert!(err.contains("emitting cylinder"), "{err}");
+}
+
+#[test]
+fn orthographic_sensor_and_crop_window_are_read() {
+    let dir = scratch("ortho");
+    let text = r#"<scene version="3.0.0">
+      <sensor type="orthographic"><float name="near_clip" value="0.5"/><float name="far_clip" value="20"/>
+        <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="8"/>
+          <integer name="crop_offset_x" value="4"/><integer name="crop_width" value="6"/>
+          <integer name="crop_offset_y" value="2"/></film></sensor>
+      <shape type="sphere"/>
+    </scene>"#;
+    let desc = read_str(text, &dir.join("scene.xml"), &[]).unwrap();
+    assert_eq!(desc.camera.projection, Projection::Orthographic);
+    assert_eq!(desc.film.crop, Some(CropWindow { offset_x: 4, offset_y: 2, width: 6, height: 6 }));
+    let world = build(&desc, &BuildOptions::default()).unwrap();
+    assert_eq!((world.camera().width, world.camera().height), (6, 6));
+    // A window past the film's edge is an error naming the film's line.
+    let bad = text.replace(r#"name="crop_width" value="6""#, r#"name="crop_width" value="13""#);
+    let err = read_str(&bad, &dir.join("scene.xml"), &[]).unwrap_err().to_string();
+    assert!(err.contains("crop window") && err.contains("scene.xml:3:"), "{err}");
+}
+
+#[test]
+fn projector_and_textured_spot_are_read() {
+    let dir = scratch("projector");
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/scenes/mitsuba/assets/texture.png"),
+        dir.join("t.png"),
+    )
+    .unwrap();
+    let desc = read(
+        &dir,
+        r#"<emitter type="projector"><float name="fov" value="30"/><float name="scale" value="2"/>
+             <rgb name="irradiance" value="1, 2, 3"/></emitter>
+           <emitter type="spot"><texture type="bitmap" name="texture"><string name="filename" value="t.png"/></texture></emitter>
+           <shape type="sphere"/>"#,
+    )
+    .unwrap();
+    assert!(matches!(desc.lights[0].light, LightKind::Projector { scale: 2.0, fov_degrees: 30.0, .. }));
+    assert!(matches!(desc.lights[1].light, LightKind::TexturedSpot { cutoff_degrees: 20.0, .. }));
+    build(&desc, &BuildOptions::default()).unwrap();
+    // A constant spot texture is rejected, as by Mitsuba.
+    let err = read(&dir, r#"<emitter type="spot"><rgb name="texture" value="0.5"/></emitter>"#).unwrap_err();
+    assert!(err.contains("spatially varying"), "{err}");
+}
+
+#[test]
+fn the_json_format_describes_the_same_features() {
+    let dir = scratch("json");
+    let text = r#"{
+      "camera": { "position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 40,
+                  "projection": "orthographic", "ortho_half_width": 2 },
+      "film": { "width": 16, "height": 8, "crop": [2, 1, 8, 4] },
+      "shapes": [ { "type": "cylinder", "p0": [0, 0, -1], "p1": [0, 0, 1], "radius": 0.5 } ],
+      "lights": [
+        { "type": "projector", "position": [0, 0, 5], "target": [0, 0, 0], "fov": 30, "irradiance": [1, 1, 1] },
+        { "type": "spot", "position": [0, 0, 5], "target": [0, 0, 0], "intensity": 3,
+          "texture": { "checkerboard": [[1, 0, 0], [0, 1, 0]] } }
+      ]
+    }"#;
+    let desc = glint::formats::json::read(&dir.join("scene.json"), text).unwrap();
+    assert_eq!(desc.camera.projection, Projection::Orthographic);
+    assert_eq!(desc.film.crop, Some(CropWindow { offset_x: 2, offset_y: 1, width: 8, height: 4 }));
+    assert!(matches!(desc.shapes[0].geometry, Geometry::Cylinder { radius: 0.5, .. }));
+    assert!(matches!(desc.lights[0].light, LightKind::Projector { fov_degrees: 30.0, .. }));
+    assert!(matches!(desc.lights[1].light, LightKind::TexturedSpot { .. }));
+    let world = build(&desc, &BuildOptions::default()).unwrap();
+    // The view is 4 units wide: a ray from the crop's left edge starts 2 - 2 * 2 * 2/16 from the axis.
+    let r = world.camera().generate_ray(0.0, 2.0, [0.5; 2]);
+    assert!((r.origin.x.abs() - 1.5).abs() < 1e-4, "{:?}", r.origin);
+}
