@@ -14,13 +14,19 @@
 //!
 //! A `Bsdf` is the material evaluated at one point: textures already looked up.
 
+mod blend;
 mod fresnel;
 mod microfacet;
 mod phong;
+mod principled;
 
+pub use blend::{BlendBsdf, BlendPart};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
 pub use microfacet::{Microfacet, MicrofacetKind};
 pub use phong::Phong;
+pub use principled::{
+    principled_alphas, principled_eta_of_specular, AnisoGgx, Principled, PrincipledInputs, PrincipledRates,
+};
 
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
@@ -50,7 +56,8 @@ pub struct BsdfSample {
     pub eta: f32,
 }
 
-#[derive(Clone, Copy, Debug)]
+/// Not `Copy`: a blend owns its two parts (see `blend.rs`); every other variant is plain data.
+#[derive(Clone, Debug)]
 pub enum Bsdf {
     /// Lambertian reflection.
     Diffuse { reflectance: Rgb },
@@ -72,6 +79,10 @@ pub enum Bsdf {
     Plastic(crate::bsdf::PlasticParams),
     /// Absorbs everything (light sources with no material).
     Black,
+    /// Mitsuba's `principled` (Disney) BSDF.
+    Principled(Principled),
+    /// Mitsuba's `blendbsdf`: a weighted mixture of two BSDFs.
+    Blend(BlendBsdf),
 }
 
 mod plastic;
@@ -83,6 +94,7 @@ impl Bsdf {
         match self {
             Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => true,
             Bsdf::Plastic(p) => p.is_delta_only(),
+            Bsdf::Blend(b) => b.is_delta(),
             _ => false,
         }
     }
@@ -91,6 +103,7 @@ impl Bsdf {
     pub fn has_delta_lobe(&self) -> bool {
         match self {
             Bsdf::Plastic(p) => p.dist.is_none(),
+            Bsdf::Blend(b) => b.has_delta_lobe(),
             _ => self.is_delta(),
         }
     }
@@ -121,6 +134,8 @@ impl Bsdf {
                 microfacet::eval_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.eval(wo, wi),
+            Bsdf::Principled(p) => p.eval(wo, wi),
+            Bsdf::Blend(b) => b.eval(wo, wi),
             Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::Black => Rgb::BLACK,
         }
     }
@@ -146,6 +161,8 @@ impl Bsdf {
                 microfacet::pdf_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.pdf(wo, wi),
+            Bsdf::Principled(p) => p.pdf(wo, wi),
+            Bsdf::Blend(b) => b.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -218,6 +235,8 @@ impl Bsdf {
             }
             Bsdf::Plastic(p) => p.sample(wo, u_lobe, u),
             Bsdf::Black => None,
+            Bsdf::Principled(p) => p.sample(wo, u_lobe, u),
+            Bsdf::Blend(b) => b.sample(wo, u_lobe, u),
         }
     }
 
@@ -228,6 +247,8 @@ impl Bsdf {
             Bsdf::Diffuse { reflectance } => *reflectance,
             Bsdf::Phong(p) => p.kd,
             Bsdf::Plastic(p) => p.diffuse,
+            Bsdf::Principled(p) => p.diffuse_reflectance(),
+            Bsdf::Blend(b) => b.diffuse_reflectance(),
             _ => Rgb::BLACK,
         }
     }

@@ -19,7 +19,9 @@ use std::path::{Path, PathBuf};
 
 mod integrator;
 pub mod limits;
+mod principled_blend;
 pub use integrator::{DirectSettings, PathSettings, Strategy, WhittedSettings};
+pub use principled_blend::{BlendDesc, BlendPartDesc, PrincipledDesc};
 
 /// A 4x4 row-major object-to-world matrix (column vectors: `p' = M p`).
 pub type Matrix4 = [[f64; 4]; 4];
@@ -140,6 +142,10 @@ pub enum MaterialModel {
     },
     /// Absorbs everything (emitters without a material).
     Black,
+    /// Mitsuba's `principled` BSDF.
+    Principled(PrincipledDesc),
+    /// Mitsuba's `blendbsdf`.
+    Blend(BlendDesc),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -394,6 +400,13 @@ impl MaterialModel {
             MaterialModel::Phong { kd, .. } => vec![kd],
             MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
             MaterialModel::Conductor { .. } | MaterialModel::Dielectric { .. } | MaterialModel::Black => vec![],
+            MaterialModel::Principled(p) => p.textures().into_iter().map(|(_, t)| t).collect(),
+            MaterialModel::Blend(b) => {
+                let mut v = vec![&b.weight];
+                v.extend(b.first.model.textures());
+                v.extend(b.second.model.textures());
+                v
+            }
         }
     }
 
@@ -403,6 +416,13 @@ impl MaterialModel {
             MaterialModel::Phong { kd, .. } => vec![kd],
             MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
             MaterialModel::Conductor { .. } | MaterialModel::Dielectric { .. } | MaterialModel::Black => vec![],
+            MaterialModel::Principled(p) => p.textures_mut().into_iter().collect(),
+            MaterialModel::Blend(b) => {
+                let mut v = vec![&mut b.weight];
+                v.extend(b.first.model.textures_mut());
+                v.extend(b.second.model.textures_mut());
+                v
+            }
         }
     }
 }

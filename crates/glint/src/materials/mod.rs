@@ -1,7 +1,9 @@
 //! Materials: what a surface is made of, with textured parameters. `Material::bsdf`
 //! evaluates the textures at a hit point and returns the [`Bsdf`] to scatter with.
 
+mod principled_blend;
 mod texture;
+pub use principled_blend::{BlendMaterial, BlendMaterialPart, PrincipledMaterial, ScalarTexture};
 pub use texture::{Bitmap, Texture};
 
 use crate::bsdf::{Bsdf, Microfacet, Phong, PlasticParams};
@@ -51,6 +53,10 @@ pub enum MaterialKind {
         params: PlasticParams,
     },
     Black,
+    /// Mitsuba's `principled`, with its textured parameters.
+    Principled(PrincipledMaterial),
+    /// Mitsuba's `blendbsdf` of two material kinds.
+    Blend(BlendMaterial),
 }
 
 #[derive(Clone, Debug)]
@@ -73,18 +79,37 @@ impl Material {
 
     /// True for materials that let light through (both faces are meaningful).
     pub fn is_transmissive(&self) -> bool {
-        matches!(
-            self.kind,
-            MaterialKind::Dielectric { .. }
-                | MaterialKind::RoughDielectric { .. }
-                | MaterialKind::ThinDielectric { .. }
-        )
+        self.kind.is_transmissive()
     }
 
     /// The reflectance a denoiser wants as its albedo guide: the diffuse texture where
     /// there is one, the specular tint of metals, the transmission tint of dielectrics.
     pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
-        match &self.kind {
+        self.kind.albedo(uv)
+    }
+
+    #[inline]
+    pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {
+        self.kind.bsdf(uv)
+    }
+}
+
+impl MaterialKind {
+    /// See [`Material::is_transmissive`].
+    pub fn is_transmissive(&self) -> bool {
+        match self {
+            MaterialKind::Dielectric { .. }
+            | MaterialKind::RoughDielectric { .. }
+            | MaterialKind::ThinDielectric { .. } => true,
+            MaterialKind::Principled(p) => p.is_transmissive(),
+            MaterialKind::Blend(b) => b.is_transmissive(),
+            _ => false,
+        }
+    }
+
+    /// See [`Material::albedo`].
+    pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
+        match self {
             MaterialKind::Diffuse { reflectance } => reflectance.eval(uv),
             MaterialKind::Phong { kd, ks, .. } => (kd.eval(uv) + *ks).map(|v| v.min(1.0)),
             MaterialKind::Conductor { specular, .. } | MaterialKind::RoughConductor { specular, .. } => *specular,
@@ -93,12 +118,15 @@ impl Material {
             | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
             MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
             MaterialKind::Black => Rgb::BLACK,
+            MaterialKind::Principled(p) => p.base_color.eval(uv),
+            MaterialKind::Blend(b) => b.albedo(uv),
         }
     }
 
+    /// The BSDF at surface point `uv`: textures looked up.
     #[inline]
     pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {
-        match &self.kind {
+        match self {
             MaterialKind::Diffuse { reflectance } => Bsdf::Diffuse { reflectance: reflectance.eval(uv) },
             MaterialKind::Phong { kd, ks, exponent } => {
                 Bsdf::Phong(Phong { kd: kd.eval(uv), ks: *ks, exponent: *exponent })
@@ -120,6 +148,8 @@ impl Material {
                 Bsdf::Plastic(PlasticParams { diffuse: diffuse.eval(uv), ..*params })
             }
             MaterialKind::Black => Bsdf::Black,
+            MaterialKind::Principled(p) => Bsdf::Principled(p.bsdf(uv)),
+            MaterialKind::Blend(b) => b.bsdf(uv),
         }
     }
 }

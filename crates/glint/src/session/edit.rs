@@ -126,6 +126,13 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
             roughness_slots(roughness, &mut out);
         }
         MaterialModel::Black => {}
+        MaterialModel::Principled(p) => {
+            for (name, t) in crate::describe::PrincipledDesc::TEXTURE_NAMES.into_iter().zip(p.textures_mut()) {
+                texture_slot(name, t, &mut out);
+            }
+        }
+        // A blend's parts are not editable one by one (yet).
+        MaterialModel::Blend(b) => texture_slot("weight", &mut b.weight, &mut out),
     }
     out
 }
