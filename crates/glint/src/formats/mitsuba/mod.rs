@@ -4,6 +4,7 @@
 //! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
 //! an error that names the plugin, the file and the line.
 
+mod bsdfs_extra;
 mod props;
 mod spectrum;
 pub mod xml;
@@ -397,6 +398,8 @@ impl<'a> Reader<'a> {
                 let roughness = if ty == "roughplastic" { Some(self.roughness(&p)?) } else { None };
                 MaterialModel::Plastic { diffuse, specular, eta, roughness }
             }
+            "principled" => self.principled(&p)?,
+            "blendbsdf" => self.blend(&p)?,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
