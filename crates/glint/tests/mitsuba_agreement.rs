@@ -165,3 +165,13 @@ fn serialized_meshes() {
 fn disk_polar_uv() {
     check("disk");
 }
+
+#[test]
+fn principled_bsdf_under_an_environment_map() {
+    check("principled");
+}
+
+#[test]
+fn blended_bsdfs_and_twosided_around_and_inside_a_blend() {
+    check("blend");
+}

@@ -9,6 +9,18 @@ use crate::error::Error;
 use crate::math::Rgb;
 
 impl<'a> Reader<'a> {
+    /// A float parameter that may be a texture. Mitsuba 3.9.1's checkerboard gives `color1`
+    /// where its colour lookup gives `color0` when read as a float (`eval_1` tests the
+    /// opposite parity), so a checkerboard read here has its two values swapped to match.
+    fn float_texture(&self, p: &Props<'a>, name: &str, default: f32) -> Result<TextureDesc, Error> {
+        Ok(match self.texture(p, name, Rgb::splat(default))? {
+            TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {
+                TextureDesc::Checkerboard { color0: color1, color1: color0, uv_scale, uv_offset }
+            }
+            t => t,
+        })
+    }
+
     pub(super) fn principled(&mut self, p: &Props<'a>) -> Result<MaterialModel, Error> {
         let el = p.el;
         let d = PrincipledDesc::default();
@@ -17,7 +29,11 @@ impl<'a> Reader<'a> {
                 TextureDesc::Constant { color } => *color,
                 _ => Rgb::BLACK,
             };
-            self.texture(p, name, fallback)
+            if name == "base_color" {
+                self.texture(p, name, fallback)
+            } else {
+                self.float_texture(p, name, fallback.r)
+            }
         };
         let spec_trans = tex("spec_trans", &d.spec_trans)?;
         // Mitsuba treats a lobe as present when its parameter is given and not the float 0.
@@ -85,7 +101,7 @@ impl<'a> Reader<'a> {
         if p.find("weight").is_none() {
             return Err(el.err("blendbsdf needs a 'weight' (a float or texture)"));
         }
-        let weight = self.texture(p, "weight", Rgb::splat(0.5))?;
+        let weight = self.float_texture(p, "weight", 0.5)?;
         let second = parts.pop().map(Box::new).expect("two parts");
         let first = parts.pop().map(Box::new).expect("two parts");
         Ok(MaterialModel::Blend(BlendDesc { weight, first, second }))
