@@ -3,7 +3,10 @@
 //! (Veach 1997, §5.2). For reflection both sides match and f is symmetric; for refraction the
 //! (η(wo)/η(wi))² radiance scaling is what makes the two sides agree.
 
-use glint::bsdf::{fresnel_dielectric, Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams};
+use glint::bsdf::{
+    fresnel_dielectric, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams, Principled,
+    PrincipledInputs, PrincipledRates,
+};
 use glint::math::{rgb, Rgb, Vec3};
 use glint::sampling::{warp, Rng};
 
@@ -29,12 +32,44 @@ fn bsdfs() -> Vec<(&'static str, Bsdf)> {
         ),
         ("smooth plastic", Bsdf::Plastic(PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, None))),
         ("rough plastic", Bsdf::Plastic(PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, Some(ggx)))),
+        ("principled, every lobe", principled(0.0)),
+        ("principled with spec_trans", principled(0.6)),
+        (
+            "blend of principled and rough gold",
+            Bsdf::Blend(BlendBsdf::new(
+                0.35,
+                BlendPart { bsdf: principled(0.0), two_sided: true },
+                BlendPart {
+                    bsdf: Bsdf::RoughConductor { dist: ggx, eta: gold.0, k: gold.1, specular: Rgb::WHITE },
+                    two_sided: false,
+                },
+            )),
+        ),
     ]
+}
+
+fn principled(spec_trans: f32) -> Bsdf {
+    Bsdf::Principled(Principled::new(&PrincipledInputs {
+        base_color: rgb(0.8, 0.4, 0.2),
+        roughness: 0.45,
+        anisotropic: 0.5,
+        metallic: 0.3,
+        spec_trans,
+        eta: 1.45,
+        spec_tint: 0.3,
+        sheen: 0.4,
+        sheen_tint: 0.5,
+        flatness: 0.3,
+        clearcoat: 0.5,
+        clearcoat_gloss: 0.2,
+        rates: PrincipledRates::default(),
+    }))
 }
 
 fn eta_of(bsdf: &Bsdf, w: Vec3) -> f32 {
     match bsdf {
         Bsdf::RoughDielectric { eta, .. } if w.z < 0.0 => *eta,
+        Bsdf::Principled(p) if w.z < 0.0 && p.spec_trans > 0.0 => p.eta,
         _ => 1.0,
     }
 }
@@ -53,8 +88,9 @@ fn bsdfs_are_reciprocal() {
             // with its square-root singularity at total internal reflection) lose most of
             // their digits and the two sides cannot agree closely.
             let h = (wi * eta_of(&bsdf, wi) + wo * eta_of(&bsdf, wo)).normalize();
-            let cos_t = match bsdf {
-                Bsdf::RoughDielectric { eta, .. } => fresnel_dielectric(wo.dot(h) * h.z.signum(), eta).cos_t,
+            let cos_t = match &bsdf {
+                Bsdf::RoughDielectric { eta, .. } => fresnel_dielectric(wo.dot(h) * h.z.signum(), *eta).cos_t,
+                Bsdf::Principled(p) if p.spec_trans > 0.0 => fresnel_dielectric(wo.dot(h) * h.z.signum(), p.eta).cos_t,
                 _ => 1.0,
             };
             if [wo.z, wi.z, wo.dot(h), wi.dot(h), cos_t].iter().any(|c| c.abs() < 0.05) {

@@ -6,7 +6,10 @@ mod common;
 
 use common::bsdf_check::{chi2_of, dir, draw_samples, integrate, BsdfCase, Integrals, Samples};
 use common::stats::{sidak, z_critical, FALSE_ALARM};
-use glint::bsdf::{normal_map_frame, Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams, ShadedBsdf};
+use glint::bsdf::{
+    normal_map_frame, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams, Principled,
+    PrincipledInputs, PrincipledRates, ShadedBsdf,
+};
 use glint::math::vec3;
 use glint::math::{rgb, Rgb};
 use rayon::prelude::*;
@@ -96,7 +99,95 @@ fn cases() -> Vec<BsdfCase> {
             v.push(tilted(&format!("rough conductor GGX 0.3 tilted {tilt}"), m, n, wo));
         }
     }
+    principled_and_blend_cases(&mut v);
     v
+}
+
+/// Mitsuba's principled defaults with `f` applied.
+fn principled(f: impl FnOnce(&mut PrincipledInputs)) -> Bsdf {
+    let mut p = PrincipledInputs {
+        base_color: rgb(0.8, 0.4, 0.2),
+        roughness: 0.5,
+        anisotropic: 0.0,
+        metallic: 0.0,
+        spec_trans: 0.0,
+        eta: 1.5,
+        spec_tint: 0.0,
+        sheen: 0.0,
+        sheen_tint: 0.0,
+        flatness: 0.0,
+        clearcoat: 0.0,
+        clearcoat_gloss: 0.0,
+        rates: PrincipledRates::default(),
+    };
+    f(&mut p);
+    Bsdf::Principled(Principled::new(&p))
+}
+
+fn blend(weight: f32, first: Bsdf, second: Bsdf, first_two_sided: bool) -> Bsdf {
+    Bsdf::Blend(BlendBsdf::new(
+        weight,
+        BlendPart { bsdf: first, two_sided: first_two_sided },
+        BlendPart { bsdf: second, two_sided: false },
+    ))
+}
+
+fn principled_and_blend_cases(v: &mut Vec<BsdfCase>) {
+    for wo in [0.0, 45.0, 80.0] {
+        v.push(case("principled defaults", principled(|_| {}), wo, false));
+    }
+    let coated = principled(|p| {
+        p.metallic = 0.7;
+        p.roughness = 0.3;
+        p.spec_tint = 0.4;
+        p.clearcoat = 0.6;
+        p.clearcoat_gloss = 0.3;
+    });
+    for wo in [30.0, 75.0] {
+        v.push(case("principled metallic clearcoat", coated.clone(), wo, false));
+    }
+    let aniso = principled(|p| {
+        p.roughness = 0.4;
+        p.anisotropic = 0.8;
+        p.sheen = 0.5;
+        p.sheen_tint = 0.5;
+        p.flatness = 0.5;
+    });
+    for wo in [20.0, 70.0] {
+        v.push(case("principled anisotropic sheen", aniso.clone(), wo, false));
+    }
+    // Below the surface, 120° is beyond the critical angle of eta 1.5 (41.8° from the normal).
+    let glassy = principled(|p| {
+        p.roughness = 0.4;
+        p.spec_trans = 0.7;
+        p.eta = 1.5;
+        p.anisotropic = 0.3;
+    });
+    for wo in [30.0, 80.0, 150.0, 120.0] {
+        v.push(case("principled spec_trans 0.7", glassy.clone(), wo, false));
+    }
+    let gold = (rgb(0.143, 0.375, 1.442), rgb(3.983, 2.386, 1.603));
+    let rough_gold = Bsdf::RoughConductor { dist: ggx(0.3), eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+    let diffuse = Bsdf::Diffuse { reflectance: rgb(0.8, 0.5, 0.2) };
+    for wo in [10.0, 70.0] {
+        v.push(case(
+            "blend 0.3 diffuse / rough gold",
+            blend(0.3, diffuse.clone(), rough_gold.clone(), false),
+            wo,
+            false,
+        ));
+    }
+    // A two-sided part seen from below: the diffuse part scatters, the gold one does not.
+    v.push(case("blend 0.5 two-sided diffuse / rough gold", blend(0.5, diffuse, rough_gold, true), 120.0, false));
+    let mirror = Bsdf::Conductor { eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+    let plastic = Bsdf::Plastic(PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, Some(ggx(0.3))));
+    for wo in [0.0, 60.0] {
+        v.push(case("blend 0.4 mirror / rough plastic", blend(0.4, mirror.clone(), plastic.clone(), false), wo, false));
+    }
+    let glass = Bsdf::RoughDielectric { dist: beckmann(0.3), eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE };
+    for wo in [40.0, 140.0] {
+        v.push(case("blend 0.6 principled / rough glass", blend(0.6, glassy.clone(), glass.clone(), false), wo, false));
+    }
 }
 
 struct Checked {

@@ -253,3 +253,13 @@ fn film_crop_window() {
 fn projector_and_textured_spot() {
     check("projector");
 }
+
+#[test]
+fn principled_bsdf_under_an_environment_map() {
+    check("principled");
+}
+
+#[test]
+fn blended_bsdfs_and_twosided_around_and_inside_a_blend() {
+    check("blend");
+}

@@ -14,15 +14,21 @@
 //!
 //! A `Bsdf` is the material evaluated at one point: textures already looked up.
 
+mod blend;
 mod fresnel;
 mod microfacet;
 mod perturbed;
 mod phong;
+mod principled;
 
+pub use blend::{BlendBsdf, BlendPart};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
 pub use microfacet::{Microfacet, MicrofacetKind};
 pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
 pub use phong::Phong;
+pub use principled::{
+    principled_alphas, principled_eta_of_specular, AnisoGgx, Principled, PrincipledInputs, PrincipledRates,
+};
 
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
@@ -52,7 +58,8 @@ pub struct BsdfSample {
     pub eta: f32,
 }
 
-#[derive(Clone, Copy, Debug)]
+/// Not `Copy`: a blend owns its two parts (see `blend.rs`); every other variant is plain data.
+#[derive(Clone, Debug)]
 pub enum Bsdf {
     /// Lambertian reflection.
     Diffuse { reflectance: Rgb },
@@ -76,6 +83,10 @@ pub enum Bsdf {
     Black,
     /// Passes light straight through, unchanged (Mitsuba's `null`): a medium's boundary.
     Null,
+    /// Mitsuba's `principled` (Disney) BSDF.
+    Principled(Principled),
+    /// Mitsuba's `blendbsdf`: a weighted mixture of two BSDFs.
+    Blend(BlendBsdf),
 }
 
 mod plastic;
@@ -87,6 +98,7 @@ impl Bsdf {
         match self {
             Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::Null => true,
             Bsdf::Plastic(p) => p.is_delta_only(),
+            Bsdf::Blend(b) => b.is_delta(),
             _ => false,
         }
     }
@@ -95,6 +107,7 @@ impl Bsdf {
     pub fn has_delta_lobe(&self) -> bool {
         match self {
             Bsdf::Plastic(p) => p.dist.is_none(),
+            Bsdf::Blend(b) => b.has_delta_lobe(),
             _ => self.is_delta(),
         }
     }
@@ -125,6 +138,8 @@ impl Bsdf {
                 microfacet::eval_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.eval(wo, wi),
+            Bsdf::Principled(p) => p.eval(wo, wi),
+            Bsdf::Blend(b) => b.eval(wo, wi),
             Bsdf::Conductor { .. }
             | Bsdf::Dielectric { .. }
             | Bsdf::ThinDielectric { .. }
@@ -154,6 +169,8 @@ impl Bsdf {
                 microfacet::pdf_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.pdf(wo, wi),
+            Bsdf::Principled(p) => p.pdf(wo, wi),
+            Bsdf::Blend(b) => b.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -227,6 +244,8 @@ impl Bsdf {
             Bsdf::Plastic(p) => p.sample(wo, u_lobe, u),
             Bsdf::Black => None,
             Bsdf::Null => Some(BsdfSample { wi: -wo, weight: Rgb::WHITE, pdf: 1.0, delta: true, eta: 1.0 }),
+            Bsdf::Principled(p) => p.sample(wo, u_lobe, u),
+            Bsdf::Blend(b) => b.sample(wo, u_lobe, u),
         }
     }
 
@@ -237,6 +256,8 @@ impl Bsdf {
             Bsdf::Diffuse { reflectance } => *reflectance,
             Bsdf::Phong(p) => p.kd,
             Bsdf::Plastic(p) => p.diffuse,
+            Bsdf::Principled(p) => p.diffuse_reflectance(),
+            Bsdf::Blend(b) => b.diffuse_reflectance(),
             _ => Rgb::BLACK,
         }
     }

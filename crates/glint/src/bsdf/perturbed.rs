@@ -13,7 +13,7 @@ use crate::math::{Frame, Rgb, Vec3};
 
 /// The BSDF a surface scatters with, and the tilted frame (expressed in the surface's shading
 /// frame) it is evaluated in, if any.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct ShadedBsdf {
     pub bsdf: Bsdf,
     pub tilt: Option<Frame>,
@@ -141,8 +141,8 @@ mod tests {
         for _ in 0..1000 {
             let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));
             let tilt = normal_map_frame(vec3(0.0, 0.0, 1.0), wo);
-            let s = ShadedBsdf { bsdf, tilt };
-            let plain = ShadedBsdf::from(bsdf);
+            let s = ShadedBsdf { bsdf: bsdf.clone(), tilt };
+            let plain = ShadedBsdf::from(bsdf.clone());
             assert!((s.eval(wo, wi) - plain.eval(wo, wi)).max_component().abs() < 1e-6);
             assert!((s.pdf(wo, wi) - plain.pdf(wo, wi)).abs() < 1e-5);
             let u = [rng.next_f32(), rng.next_f32()];

@@ -15,13 +15,16 @@ pub use cache::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
 
 use crate::accel::BvhSplit;
 use crate::bsdf::Microfacet;
+use crate::bsdf::PrincipledRates;
 use crate::camera::Camera;
 use crate::describe::{
     CameraDesc, Geometry, LightKind, MaterialModel, MaterialRef, Matrix4, Roughness, SceneDesc, TextureDesc,
 };
 use crate::error::{Error, SourceLoc};
 use crate::lights::{Light, ProjectedKind, ProjectedLight};
-use crate::materials::{Bitmap, Material, MaterialKind, Texture};
+use crate::materials::{
+    Bitmap, BlendMaterial, BlendMaterialPart, Material, MaterialKind, PrincipledMaterial, ScalarTexture, Texture,
+};
 use crate::math::{Aabb, Frame, Mat4, Transform, Vec3};
 use crate::world::World;
 use std::collections::{BTreeSet, HashMap};
@@ -131,7 +134,38 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
             nested: Box::new(material_kind(nested, textures)?),
         },
         MaterialModel::Null => MaterialKind::Null,
+        MaterialModel::Principled(p) => principled_kind(p, textures)?,
+        MaterialModel::Blend(b) => {
+            let mut part = |p: &crate::describe::BlendPartDesc| -> Result<BlendMaterialPart, Error> {
+                Ok(BlendMaterialPart { kind: material_kind(&p.model, textures)?, two_sided: p.two_sided })
+            };
+            let (first, second) = (part(&b.first)?, part(&b.second)?);
+            MaterialKind::Blend(BlendMaterial::new(ScalarTexture::new(textures.texture(&b.weight)?), first, second))
+        }
     })
+}
+
+fn principled_kind(p: &crate::describe::PrincipledDesc, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
+    let mut scalar = |t: &TextureDesc| -> Result<ScalarTexture, Error> { Ok(ScalarTexture::new(textures.texture(t)?)) };
+    Ok(MaterialKind::Principled(PrincipledMaterial {
+        roughness: scalar(&p.roughness)?,
+        anisotropic: scalar(&p.anisotropic)?,
+        metallic: scalar(&p.metallic)?,
+        spec_trans: scalar(&p.spec_trans)?,
+        eta: p.eta,
+        spec_tint: scalar(&p.spec_tint)?,
+        sheen: scalar(&p.sheen)?,
+        sheen_tint: scalar(&p.sheen_tint)?,
+        flatness: scalar(&p.flatness)?,
+        clearcoat: scalar(&p.clearcoat)?,
+        clearcoat_gloss: scalar(&p.clearcoat_gloss)?,
+        base_color: textures.texture(&p.base_color)?,
+        rates: PrincipledRates {
+            diffuse: p.diffuse_sampling_rate,
+            specular: p.specular_sampling_rate,
+            clearcoat: p.clearcoat_sampling_rate,
+        },
+    }))
 }
 
 fn material_id(b: &mut WorldBuilder, r: MaterialRef, ids: &[u32]) -> Result<u32, Error> {

@@ -218,6 +218,49 @@ fn material(m: &MaterialModel) -> Result<(), String> {
             material(nested)?;
         }
         MaterialModel::NormalMap { nested, .. } | MaterialModel::Mask { nested, .. } => material(nested)?,
+        MaterialModel::Principled(p) => principled(p, eta_ok)?,
+        MaterialModel::Blend(b) => {
+            // Each part is checked as a material of its own (its textures included).
+            material(&b.first.model).map_err(|e| format!("blend, first part: {e}"))?;
+            material(&b.second.model).map_err(|e| format!("blend, second part: {e}"))?;
+        }
+    }
+    Ok(())
+}
+
+/// Mitsuba documents every principled parameter but `eta` and the sampling rates as lying
+/// in [0, 1]; out of it the model has no meaning (anisotropic above 1/0.9 is a NaN).
+fn principled(p: &crate::describe::PrincipledDesc, eta_ok: impl Fn(f32) -> Result<(), String>) -> Result<(), String> {
+    eta_ok(p.eta)?;
+    for (name, t) in p.textures() {
+        let unit = |c: Rgb| -> Result<(), String> {
+            if name != "base_color" && c.to_array().iter().any(|v| *v > 1.0) {
+                return Err(format!("principled: {name} ({}, {}, {}) must lie in [0, 1]", c.r, c.g, c.b));
+            }
+            Ok(())
+        };
+        match t {
+            TextureDesc::Constant { color: c } => unit(*c)?,
+            TextureDesc::Checkerboard { color0, color1, .. } => {
+                unit(*color0)?;
+                unit(*color1)?;
+            }
+            // Images are clamped to [0, 1] by their formats or read as given (EXR).
+            TextureDesc::Bitmap { .. } | TextureDesc::MeshAttribute { .. } => {}
+        }
+    }
+    for (rate, name) in [
+        (p.diffuse_sampling_rate, "diffuse_reflectance_sampling_rate"),
+        (p.specular_sampling_rate, "main_specular_sampling_rate"),
+        (p.clearcoat_sampling_rate, "clearcoat_sampling_rate"),
+    ] {
+        if !(rate >= 0.0 && rate.is_finite()) {
+            return Err(format!("principled: {name} {rate} must be finite and not negative"));
+        }
+    }
+    if !(p.specular_sampling_rate > 0.0) {
+        // The main lobe must be sampleable: it is the only one seen from inside.
+        return Err("principled: main_specular_sampling_rate must be positive".to_string());
     }
     Ok(())
 }

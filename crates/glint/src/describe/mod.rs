@@ -20,8 +20,10 @@ use std::path::{Path, PathBuf};
 mod integrator;
 pub mod limits;
 mod medium;
+mod principled_blend;
 pub use integrator::{DirectSettings, PathSettings, Strategy, WhittedSettings};
 pub use medium::{MediumDesc, PhaseDesc, VolpathSettings};
+pub use principled_blend::{BlendDesc, BlendPartDesc, PrincipledDesc};
 
 /// A 4x4 row-major object-to-world matrix (column vectors: `p' = M p`).
 pub type Matrix4 = [[f64; 4]; 4];
@@ -173,6 +175,10 @@ pub enum MaterialModel {
     },
     /// Lets light through unchanged (Mitsuba's `null`): the boundary of a medium.
     Null,
+    /// Mitsuba's `principled` BSDF.
+    Principled(PrincipledDesc),
+    /// Mitsuba's `blendbsdf`.
+    Blend(BlendDesc),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -497,6 +503,13 @@ impl MaterialModel {
                 v.extend(nested.textures());
                 v
             }
+            MaterialModel::Principled(p) => p.textures().into_iter().map(|(_, t)| t).collect(),
+            MaterialModel::Blend(b) => {
+                let mut v = vec![&b.weight];
+                v.extend(b.first.model.textures());
+                v.extend(b.second.model.textures());
+                v
+            }
         }
     }
 
@@ -514,6 +527,13 @@ impl MaterialModel {
             | MaterialModel::Mask { opacity: t, nested } => {
                 let mut v = vec![t];
                 v.extend(nested.textures_mut());
+                v
+            }
+            MaterialModel::Principled(p) => p.textures_mut().into_iter().collect(),
+            MaterialModel::Blend(b) => {
+                let mut v = vec![&mut b.weight];
+                v.extend(b.first.model.textures_mut());
+                v.extend(b.second.model.textures_mut());
                 v
             }
         }

@@ -7,6 +7,7 @@
 use super::json_spans::Spans;
 use crate::bsdf::MicrofacetKind;
 use crate::camera::{CropWindow, FovAxis, Projection};
+use crate::describe::{BlendDesc, BlendPartDesc, PrincipledDesc};
 use crate::describe::{
     CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
     MaterialModel, MaterialRef, Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc,
@@ -264,6 +265,34 @@ enum JsonMaterial {
     Mask { opacity: JsonTexture, material: Box<JsonMaterial> },
     /// Lets light through unchanged: a medium's boundary.
     Null {},
+    /// Mitsuba's principled BSDF; every key optional, with Mitsuba's defaults.
+    Principled(Box<JsonPrincipled>),
+    /// (1 - weight) · first + weight · second.
+    Blend {
+        weight: JsonTexture,
+        materials: Box<[JsonMaterial; 2]>,
+        #[serde(default)]
+        two_sided: Option<bool>,
+    },
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct JsonPrincipled {
+    base_color: Option<JsonTexture>,
+    roughness: Option<JsonTexture>,
+    anisotropic: Option<JsonTexture>,
+    metallic: Option<JsonTexture>,
+    spec_trans: Option<JsonTexture>,
+    ior: Option<f32>,
+    specular: Option<f32>,
+    spec_tint: Option<JsonTexture>,
+    sheen: Option<JsonTexture>,
+    sheen_tint: Option<JsonTexture>,
+    flatness: Option<JsonTexture>,
+    clearcoat: Option<JsonTexture>,
+    clearcoat_gloss: Option<JsonTexture>,
+    two_sided: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -574,10 +603,49 @@ fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(
             true,
         ),
         JsonMaterial::Null {} => (MaterialModel::Null, false),
+        JsonMaterial::Principled(p) => principled_of(ctx, &at, p)?,
+        JsonMaterial::Blend { weight, materials, two_sided } => {
+            let part = |i: usize| -> Result<Box<BlendPartDesc>, Error> {
+                let m = material_of(ctx, &format!("{name}/materials/{i}"), &materials[i])?;
+                Ok(Box::new(BlendPartDesc { model: m.model, two_sided: m.two_sided }))
+            };
+            let weight = texture_of(ctx, &format!("{at}/weight"), weight);
+            (MaterialModel::Blend(BlendDesc { weight, first: part(0)?, second: part(1)? }), two_sided.unwrap_or(true))
+        }
         JsonMaterial::NormalMap { .. } | JsonMaterial::BumpMap { .. } | JsonMaterial::Mask { .. } => {
             return material_model_of(ctx, name, &at, m)
         }
     })
+}
+
+fn principled_of(ctx: &Ctx, at: &str, p: &JsonPrincipled) -> Result<(MaterialModel, bool), Error> {
+    let d = PrincipledDesc::default();
+    let tex = |key: &str, t: &Option<JsonTexture>, default: TextureDesc| match t {
+        Some(t) => texture_of(ctx, &format!("{at}/{key}"), t),
+        None => default,
+    };
+    let eta = match (p.ior, p.specular) {
+        (Some(_), Some(_)) => return Err(ctx.err(at, "principled: give either 'ior' or 'specular', not both")),
+        (Some(ior), None) => ior,
+        (None, Some(s)) => crate::bsdf::principled_eta_of_specular(s),
+        (None, None) => d.eta,
+    };
+    let desc = PrincipledDesc {
+        base_color: tex("base_color", &p.base_color, d.base_color.clone()),
+        roughness: tex("roughness", &p.roughness, d.roughness.clone()),
+        anisotropic: tex("anisotropic", &p.anisotropic, d.anisotropic.clone()),
+        metallic: tex("metallic", &p.metallic, d.metallic.clone()),
+        spec_trans: tex("spec_trans", &p.spec_trans, d.spec_trans.clone()),
+        eta,
+        spec_tint: tex("spec_tint", &p.spec_tint, d.spec_tint.clone()),
+        sheen: tex("sheen", &p.sheen, d.sheen.clone()),
+        sheen_tint: tex("sheen_tint", &p.sheen_tint, d.sheen_tint.clone()),
+        flatness: tex("flatness", &p.flatness, d.flatness.clone()),
+        clearcoat: tex("clearcoat", &p.clearcoat, d.clearcoat.clone()),
+        clearcoat_gloss: tex("clearcoat_gloss", &p.clearcoat_gloss, d.clearcoat_gloss.clone()),
+        ..d
+    };
+    Ok((MaterialModel::Principled(desc), p.two_sided.unwrap_or(true)))
 }
 
 /// Reads a JSON scene (`text` is the file's contents) into a description.

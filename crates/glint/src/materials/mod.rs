@@ -2,8 +2,10 @@
 //! evaluates the textures at a hit point and returns the [`Bsdf`] to scatter with.
 
 mod conductor_presets;
+mod principled_blend;
 mod surface;
 mod texture;
+pub use principled_blend::{BlendMaterial, BlendMaterialPart, PrincipledMaterial, ScalarTexture};
 pub use surface::Perturbation;
 pub use texture::{Bitmap, Texture, TexturePoint};
 
@@ -75,6 +77,10 @@ pub enum MaterialKind {
     },
     /// Lets light through unchanged: a medium's boundary.
     Null,
+    /// Mitsuba's `principled`, with its textured parameters.
+    Principled(PrincipledMaterial),
+    /// Mitsuba's `blendbsdf` of two material kinds.
+    Blend(BlendMaterial),
 }
 
 #[derive(Clone, Debug)]
@@ -97,31 +103,16 @@ impl Material {
 
     /// True for materials that let light through (both faces are meaningful).
     pub fn is_transmissive(&self) -> bool {
-        matches!(
-            self.kind.base(),
-            MaterialKind::Dielectric { .. }
-                | MaterialKind::RoughDielectric { .. }
-                | MaterialKind::ThinDielectric { .. }
-                | MaterialKind::Null
-        )
+        self.kind.base().is_transmissive()
     }
 
     /// The reflectance a denoiser wants as its albedo guide: the diffuse texture where
     /// there is one, the specular tint of metals, the transmission tint of dielectrics.
     pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
-        match self.kind.base() {
-            MaterialKind::Diffuse { reflectance } => reflectance.eval(uv),
-            MaterialKind::Phong { kd, ks, .. } => (kd.eval(uv) + *ks).map(|v| v.min(1.0)),
-            MaterialKind::Conductor { specular, .. } | MaterialKind::RoughConductor { specular, .. } => *specular,
-            MaterialKind::Dielectric { transmit, .. }
-            | MaterialKind::RoughDielectric { transmit, .. }
-            | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
-            MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
-            MaterialKind::Null => Rgb::WHITE,
-            _ => Rgb::BLACK,
-        }
+        self.kind.base().albedo(uv)
     }
 
+    /// The BSDF at surface point `uv`: textures looked up.
     #[inline]
     pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {
         self.bsdf_at(&TexturePoint::uv(uv))
@@ -131,7 +122,52 @@ impl Material {
     /// masks: those are applied by the integrators, see [`Perturbation`]).
     #[inline]
     pub fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
-        match self.kind.base() {
+        self.kind.base().bsdf_at(p)
+    }
+}
+
+impl MaterialKind {
+    /// See [`Material::is_transmissive`].
+    pub fn is_transmissive(&self) -> bool {
+        match self {
+            MaterialKind::Dielectric { .. }
+            | MaterialKind::RoughDielectric { .. }
+            | MaterialKind::ThinDielectric { .. }
+            | MaterialKind::Null => true,
+            MaterialKind::Principled(p) => p.is_transmissive(),
+            MaterialKind::Blend(b) => b.is_transmissive(),
+            _ => false,
+        }
+    }
+
+    /// See [`Material::albedo`].
+    pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
+        match self {
+            MaterialKind::Diffuse { reflectance } => reflectance.eval(uv),
+            MaterialKind::Phong { kd, ks, .. } => (kd.eval(uv) + *ks).map(|v| v.min(1.0)),
+            MaterialKind::Conductor { specular, .. } | MaterialKind::RoughConductor { specular, .. } => *specular,
+            MaterialKind::Dielectric { transmit, .. }
+            | MaterialKind::RoughDielectric { transmit, .. }
+            | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
+            MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
+            MaterialKind::Null => Rgb::WHITE,
+            MaterialKind::Principled(p) => p.base_color.eval(uv),
+            MaterialKind::Blend(b) => b.albedo(uv),
+            _ => Rgb::BLACK,
+        }
+    }
+
+    /// The BSDF at surface point `uv` (see [`MaterialKind::bsdf_at`]).
+    #[inline]
+    pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {
+        self.bsdf_at(&TexturePoint::uv(uv))
+    }
+
+    /// This kind's BSDF at a hit point; wrappers (normal and bump maps, masks) are black here,
+    /// their nested material being found by [`MaterialKind::base`].
+    #[inline]
+    pub fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
+        match self {
             MaterialKind::Diffuse { reflectance } => Bsdf::Diffuse { reflectance: reflectance.eval_at(p) },
             MaterialKind::Phong { kd, ks, exponent } => {
                 Bsdf::Phong(Phong { kd: kd.eval_at(p), ks: *ks, exponent: *exponent })
@@ -157,6 +193,8 @@ impl Material {
             | MaterialKind::BumpMap { .. }
             | MaterialKind::Mask { .. } => Bsdf::Black,
             MaterialKind::Null => Bsdf::Null,
+            MaterialKind::Principled(pr) => Bsdf::Principled(pr.bsdf(p.uv)),
+            MaterialKind::Blend(b) => b.bsdf(p.uv),
         }
     }
 }

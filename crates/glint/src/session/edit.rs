@@ -136,6 +136,13 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
             texture_slot("opacity", opacity, &mut out);
             out.extend(material_slots(nested));
         }
+        MaterialModel::Principled(p) => {
+            for (name, t) in crate::describe::PrincipledDesc::TEXTURE_NAMES.into_iter().zip(p.textures_mut()) {
+                texture_slot(name, t, &mut out);
+            }
+        }
+        // A blend's parts are not editable one by one (yet).
+        MaterialModel::Blend(b) => texture_slot("weight", &mut b.weight, &mut out),
     }
     out
 }

@@ -4,6 +4,7 @@
 //! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
 //! an error that names the plugin, the file and the line.
 
+mod bsdfs_extra;
 mod instances;
 mod media;
 mod projected;
@@ -454,6 +455,8 @@ impl<'a> Reader<'a> {
             }
             // Passes light through unchanged: the boundary of a medium (see the volpath integrator).
             "null" => MaterialModel::Null,
+            "principled" => self.principled(&p)?,
+            "blendbsdf" => self.blend(&p)?,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
