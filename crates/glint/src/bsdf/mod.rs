@@ -72,10 +72,14 @@ pub enum Bsdf {
     Plastic(crate::bsdf::PlasticParams),
     /// Absorbs everything (light sources with no material).
     Black,
+    /// Mitsuba's `pplastic` as its unpolarized variants render it.
+    PPlastic(PPlasticParams),
 }
 
 mod plastic;
+mod pplastic;
 pub use plastic::PlasticParams;
+pub use pplastic::PPlasticParams;
 
 impl Bsdf {
     /// True when every lobe is a delta: light sampling is pointless there.
@@ -121,6 +125,7 @@ impl Bsdf {
                 microfacet::eval_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.eval(wo, wi),
+            Bsdf::PPlastic(p) => p.eval(wo, wi),
             Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::Black => Rgb::BLACK,
         }
     }
@@ -146,6 +151,7 @@ impl Bsdf {
                 microfacet::pdf_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.pdf(wo, wi),
+            Bsdf::PPlastic(p) => p.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -217,6 +223,7 @@ impl Bsdf {
                 microfacet::sample_rough_dielectric(dist, *eta, *reflect, *transmit, wo, u_lobe, u)
             }
             Bsdf::Plastic(p) => p.sample(wo, u_lobe, u),
+            Bsdf::PPlastic(p) => p.sample(wo, u_lobe, u),
             Bsdf::Black => None,
         }
     }
@@ -228,6 +235,7 @@ impl Bsdf {
             Bsdf::Diffuse { reflectance } => *reflectance,
             Bsdf::Phong(p) => p.kd,
             Bsdf::Plastic(p) => p.diffuse,
+            Bsdf::PPlastic(p) => p.diffuse,
             _ => Rgb::BLACK,
         }
     }

@@ -16,6 +16,8 @@ use crate::math::{Aabb, Frame, Ray, Transform, Vec3};
 use crate::sampling::Distribution1d;
 use std::sync::Arc;
 
+mod tangent;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShapeRef {
     Mesh(u32),
@@ -292,10 +294,11 @@ impl World {
         if !n_shading.is_finite() {
             n_shading = ng;
         }
+        let dpdu = self.surface_dpdu(inst, hit, p);
         SurfaceInteraction {
             p,
             ng,
-            frame: Frame::from_normal(n_shading),
+            frame: tangent::shading_frame(n_shading, ng, dpdu),
             uv,
             instance: hit.instance,
             material: inst.material,

@@ -4,22 +4,24 @@
 //! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
 //! an error that names the plugin, the file and the line.
 
+mod polarized;
 mod props;
+mod roughness;
 mod spectrum;
 pub mod xml;
 
 use super::Define;
-use crate::bsdf::MicrofacetKind;
 use crate::camera::FovAxis;
 use crate::describe::{
     CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
-    MaterialRef, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, TextureDesc,
+    MaterialRef, PathSettings, SamplerDesc, SceneDesc, ShapeDesc, TextureDesc,
 };
 use crate::error::{Error, SourceLoc};
 use crate::materials::conductor_preset;
 use crate::math::{Rgb, Transform, Vec3};
 use crate::sampling::{PixelFilter, SamplerKind};
 use props::{color_of, Props};
+use roughness::RoughnessInput;
 use spectrum::SpectrumUse;
 use std::collections::HashMap;
 use std::path::Path;
@@ -312,23 +314,6 @@ impl<'a> Reader<'a> {
         }
     }
 
-    fn roughness(&self, p: &Props) -> Result<Roughness, Error> {
-        let distribution = match p.string("distribution").unwrap_or("beckmann") {
-            "beckmann" => MicrofacetKind::Beckmann,
-            "ggx" => MicrofacetKind::Ggx,
-            other => return Err(p.el.err(format!("unknown microfacet distribution '{other}'"))),
-        };
-        let alpha = match (p.opt_float("alpha_u")?, p.opt_float("alpha_v")?) {
-            (Some(u), Some(v)) if (u - v).abs() > 1e-6 => {
-                return Err(p.el.err("anisotropic roughness (alpha_u != alpha_v) is not supported"))
-            }
-            (Some(u), _) => u,
-            _ => p.float("alpha", 0.1)?,
-        };
-        let _ = p.bool("sample_visible", true)?;
-        Ok(Roughness { distribution, alpha })
-    }
-
     fn conductor_ior(&self, p: &Props) -> Result<(Rgb, Rgb), Error> {
         let (eta_el, k_el) = (p.find("eta"), p.find("k"));
         if eta_el.is_some() || k_el.is_some() {
@@ -338,8 +323,11 @@ impl<'a> Reader<'a> {
             ));
         }
         let name = p.string("material").unwrap_or("none");
-        conductor_preset(name)
-            .ok_or_else(|| p.el.err(format!("conductor material '{name}' is not known (Au, Ag, Cu, Al, Cr, none)")))
+        conductor_preset(name).ok_or_else(|| {
+            p.el.err(format!(
+                "conductor material '{name}' is not known (Mitsuba's presets: see docs/mitsuba-support.md)"
+            ))
+        })
     }
 
     /// Describes (once) the material of a `<bsdf>` element; its index in the materials.
@@ -376,7 +364,8 @@ impl<'a> Reader<'a> {
             }
             "diffuse" => MaterialModel::Diffuse { reflectance: self.texture(&p, "reflectance", Rgb::splat(0.5))? },
             "conductor" | "roughconductor" => {
-                let roughness = if ty == "roughconductor" { Some(self.roughness(&p)?) } else { None };
+                let roughness =
+                    if ty == "roughconductor" { Some(self.roughness(&p, RoughnessInput::Textured)?) } else { None };
                 let (eta, k) = self.conductor_ior(&p)?;
                 MaterialModel::Conductor { eta, k, specular: p.rgb("specular_reflectance", Rgb::WHITE)?, roughness }
             }
@@ -384,19 +373,24 @@ impl<'a> Reader<'a> {
                 let eta = self.ior(&p, "int_ior", 1.5046)? / self.ior(&p, "ext_ior", 1.000277)?;
                 let reflect = p.rgb("specular_reflectance", Rgb::WHITE)?;
                 let transmit = p.rgb("specular_transmittance", Rgb::WHITE)?;
-                let roughness = if ty == "roughdielectric" { Some(self.roughness(&p)?) } else { None };
+                let roughness =
+                    if ty == "roughdielectric" { Some(self.roughness(&p, RoughnessInput::Textured)?) } else { None };
                 MaterialModel::Dielectric { eta, reflect, transmit, roughness, thin: ty == "thindielectric" }
             }
             "plastic" | "roughplastic" => {
                 let eta = self.ior(&p, "int_ior", 1.49)? / self.ior(&p, "ext_ior", 1.000277)?;
                 let diffuse = self.texture(&p, "diffuse_reflectance", Rgb::splat(0.5))?;
                 let specular = p.rgb("specular_reflectance", Rgb::WHITE)?;
-                if p.bool("nonlinear", false)? {
-                    return Err(el.err(format!("{ty}: nonlinear=true is not supported")));
-                }
-                let roughness = if ty == "roughplastic" { Some(self.roughness(&p)?) } else { None };
-                MaterialModel::Plastic { diffuse, specular, eta, roughness }
+                let nonlinear = p.bool("nonlinear", false)?;
+                let roughness = if ty == "roughplastic" {
+                    Some(self.roughness(&p, RoughnessInput::IsotropicNumber)?)
+                } else {
+                    None
+                };
+                MaterialModel::Plastic { diffuse, specular, eta, roughness, nonlinear }
             }
+            "pplastic" => self.pplastic(&p)?,
+            "polarizer" => self.polarizer(&p)?,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
