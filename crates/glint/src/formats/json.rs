@@ -211,6 +211,25 @@ enum JsonMaterial {
         #[serde(default)]
         nonlinear: bool,
     },
+    /// Mitsuba's `pplastic` as its RGB variants render it.
+    Pplastic {
+        diffuse: JsonTexture,
+        #[serde(default)]
+        specular: Option<JsonColor>,
+        #[serde(default)]
+        ior: Option<f32>,
+        #[serde(default)]
+        alpha: Option<JsonTexture>,
+        #[serde(default)]
+        alpha_v: Option<JsonTexture>,
+        #[serde(default)]
+        distribution: Option<String>,
+    },
+    /// Mitsuba's `polarizer` on unpolarized light: passes half of `transmittance`.
+    Polarizer {
+        #[serde(default)]
+        transmittance: Option<JsonColor>,
+    },
 }
 
 #[derive(Deserialize)]
@@ -472,6 +491,32 @@ fn material_of(ctx: &Ctx, name: &str, m: &JsonMaterial) -> Result<MaterialDesc, 
                 nonlinear: *nonlinear,
             },
             true,
+        ),
+        JsonMaterial::Pplastic { diffuse, specular, ior, alpha, alpha_v, distribution } => {
+            // Mitsuba's defaults: Beckmann, alpha 0.1.
+            let alpha = alpha.clone().or(Some(JsonTexture::Color(JsonColor::Grey(0.1))));
+            let name = distribution.clone().or(Some("beckmann".into()));
+            let roughness = roughness(ctx, &at, &name, &alpha, alpha_v)?
+                .ok_or_else(|| ctx.err(&format!("{at}/alpha"), "pplastic needs a positive alpha"))?;
+            (
+                MaterialModel::PPlastic {
+                    diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
+                    specular: specular.map_or(Rgb::WHITE, |c| c.rgb()),
+                    eta: ior.unwrap_or(1.49),
+                    roughness,
+                },
+                true,
+            )
+        }
+        JsonMaterial::Polarizer { transmittance } => (
+            MaterialModel::Dielectric {
+                eta: 1.0,
+                reflect: Rgb::BLACK,
+                transmit: transmittance.map_or(Rgb::WHITE, |c| c.rgb()) * 0.5,
+                roughness: None,
+                thin: true,
+            },
+            false,
         ),
     };
     Ok(MaterialDesc { name: name.to_string(), model, two_sided, loc: ctx.loc(&at) })
