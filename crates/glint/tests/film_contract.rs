@@ -1,6 +1,6 @@
 //! The film's contract: however the samples are scheduled (one go, pass ranges merged, pixel
 //! regions merged, 1/2/3 threads, a checkpoint written, read back and continued), the image
-//! and every AOV layer are bit-identical; AOV layers match analytic values; adaptive
+//! and every AOV layer are bit-identical, with the box filter and with splatting filters; AOV layers match analytic values; adaptive
 //! sampling keeps the image mean within noise while sampling flat regions less.
 
 mod common;
@@ -16,7 +16,7 @@ use glint::render::{
     read_film, render, render_passes, write_film, Adaptive, Aov, Film, FilmMeta, PassRequest, Rect, RenderSettings,
     Silent,
 };
-use glint::sampling::SamplerKind;
+use glint::sampling::{PixelFilter, SamplerKind};
 use glint::world::World;
 use std::sync::atomic::AtomicBool;
 
@@ -46,6 +46,10 @@ fn new_film(region: Rect) -> Film {
     Film::new(W, H, region, PASS_SPP, SPP, &Aov::ALL).unwrap()
 }
 
+fn new_filtered_film(region: Rect, filter: PixelFilter) -> Film {
+    Film::with_filter(W, H, region, PASS_SPP, SPP, &Aov::ALL, filter).unwrap()
+}
+
 fn run(
     scene: &World,
     integrator: &Integrator,
@@ -54,8 +58,9 @@ fn run(
     adaptive: Option<Adaptive>,
 ) {
     let request = PassRequest { passes, adaptive };
+    let settings = RenderSettings { filter: film.filter(), ..settings() };
     let outcome =
-        render_passes(scene, integrator, &settings(), film, &request, &AtomicBool::new(false), &Silent).unwrap();
+        render_passes(scene, integrator, &settings, film, &request, &AtomicBool::new(false), &Silent).unwrap();
     assert!(!outcome.cancelled);
     assert_eq!(outcome.stats.discarded_samples, 0);
 }
@@ -74,8 +79,18 @@ fn bits(film: &Film) -> Vec<u32> {
 }
 
 fn one_shot(scene: &World, integrator: &Integrator, threads: usize, adaptive: Option<Adaptive>) -> Film {
+    one_shot_filtered(scene, integrator, threads, adaptive, PixelFilter::Box)
+}
+
+fn one_shot_filtered(
+    scene: &World,
+    integrator: &Integrator,
+    threads: usize,
+    adaptive: Option<Adaptive>,
+    filter: PixelFilter,
+) -> Film {
     on_threads(threads, || {
-        let mut f = new_film(Rect::full(W, H));
+        let mut f = new_filtered_film(Rect::full(W, H), filter);
         run(scene, integrator, &mut f, 0..3, adaptive);
         f
     })
@@ -83,19 +98,35 @@ fn one_shot(scene: &World, integrator: &Integrator, threads: usize, adaptive: Op
 
 #[test]
 fn every_schedule_gives_the_same_bits() {
+    every_schedule_gives_the_same_bits_with(PixelFilter::Box, "box");
+}
+
+#[test]
+fn every_schedule_gives_the_same_bits_when_splatting() {
+    every_schedule_gives_the_same_bits_with(PixelFilter::Gaussian { stddev: 0.5 }, "gaussian");
+    every_schedule_gives_the_same_bits_with(PixelFilter::Tent { radius: 1.5 }, "tent");
+}
+
+fn every_schedule_gives_the_same_bits_with(filter: PixelFilter, filter_name: &str) {
     let scene = contract_scene();
     let integrators = [("path", path(Strategy::Mis)), ("Whitted", Integrator::Whitted(WhittedSettings::default()))];
-    let dir = std::env::temp_dir().join(format!("glint-film-contract-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("glint-film-contract-{filter_name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    let new_film = |region| new_filtered_film(region, filter);
+    let settings = || RenderSettings { filter, ..settings() };
     for (name, integrator) in &integrators {
-        let reference_film = one_shot(&scene, integrator, 2, None);
+        let name = &format!("{name}, {filter_name} filter");
+        let reference_film = one_shot_filtered(&scene, integrator, 2, None, filter);
         assert!(reference_film.is_complete());
         let reference = bits(&reference_film);
         let image_len = (W * H * 3) as usize;
         assert!(reference[..image_len].iter().any(|&b| b != 0), "{name}: black image");
 
         for threads in [1, 3] {
-            assert!(bits(&one_shot(&scene, integrator, threads, None)) == reference, "{name}: {threads} threads");
+            assert!(
+                bits(&one_shot_filtered(&scene, integrator, threads, None, filter)) == reference,
+                "{name}: {threads} threads"
+            );
         }
 
         // Pass ranges rendered into two films and merged (the later one first, for good measure).

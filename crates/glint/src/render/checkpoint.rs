@@ -1,16 +1,18 @@
 //! Films on disk (checkpoints), so that a render can stop and resume, or be split across
 //! machines and merged.
 //!
-//! Format version 1, all integers little-endian:
+//! Format version 2, all integers little-endian (version 1, without `filter` and splat sums,
+//! is still read: its films are box-filtered):
 //!
 //! | bytes | content |
 //! |---|---|
 //! | 8 | magic `GLINTFLM` |
 //! | 4 | format version (`u32`) |
 //! | 4 | header length `H` (`u32`) |
-//! | H | header, UTF-8 JSON: `width`, `height`, `region`, `pass_spp`, `spp`, `aovs` (names), `blocks`, `scene_hash`, `settings` |
+//! | H | header, UTF-8 JSON: `width`, `height`, `region`, `pass_spp`, `spp`, `aovs` (names), `blocks`, `scene_hash`, `settings`, `filter` |
 //! | … | per pixel of the region, row-major: Σf (3 × `i128`), Σf² (3 × `i128`), count (`u64`), converged (`u8`) |
 //! | … | per pixel of the region: the stored AOV sums (`i128` each, in the header's AOV order) |
+//! | … | when the filter splats, per pixel of the splat rectangle (the region grown by the filter's margin, inside the image), row-major: Σw·f (3 × `i128`), Σw (`i128`) |
 //! | 8 | FNV-1a 64 checksum of every byte before it |
 //!
 //! `scene_hash` and `settings` are opaque to the film: the caller fills them (a
@@ -19,15 +21,18 @@
 
 use super::aov::Aov;
 use super::film::{Block, Film, FilmParts, PixelSums, Rect};
+use super::splat::{splat_rect, SplatSums};
+use crate::sampling::PixelFilter;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;
 
 const MAGIC: &[u8; 8] = b"GLINTFLM";
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 const PREFIX_BYTES: usize = 16;
 const CHECKSUM_BYTES: usize = 8;
 const PIXEL_BYTES: usize = 6 * 16 + 8 + 1;
+const SPLAT_BYTES: usize = 4 * 16;
 /// Largest header accepted: blocks are few, settings are a line of JSON.
 const MAX_HEADER_BYTES: usize = 64 << 20;
 
@@ -82,6 +87,8 @@ struct Header {
     blocks: Vec<Block>,
     scene_hash: u64,
     settings: String,
+    #[serde(default)]
+    filter: PixelFilter,
 }
 
 /// The whole file as bytes.
@@ -97,6 +104,7 @@ pub fn encode_film(film: &Film, meta: &FilmMeta) -> Vec<u8> {
         blocks: p.blocks,
         scene_hash: meta.scene_hash,
         settings: meta.settings.clone(),
+        filter: p.filter,
     };
     let json = serde_json::to_vec(&header).expect("the header serialises");
     let mut out =
@@ -114,6 +122,11 @@ pub fn encode_film(film: &Film, meta: &FilmMeta) -> Vec<u8> {
     }
     for v in &p.aov_sums {
         out.extend_from_slice(&v.to_le_bytes());
+    }
+    for s in &p.splat {
+        for v in s.sum.iter().chain([&s.weight]) {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
     }
     let sum = content_hash(&out);
     out.extend_from_slice(&sum.to_le_bytes());
@@ -183,7 +196,11 @@ pub fn decode_film(bytes: &[u8]) -> Result<(Film, FilmMeta), String> {
     // The region fits in the image (u32 sides), so these products fit in u128 and are
     // compared to the file length before anything is allocated.
     let pixels = region.area() as u128;
-    let expected = (PREFIX_BYTES + header_len + CHECKSUM_BYTES) as u128 + pixels * (PIXEL_BYTES + 16 * stride) as u128;
+    let splats =
+        if header.filter.splats() { splat_rect(region, &header.filter, header.width, header.height).area() } else { 0 };
+    let expected = (PREFIX_BYTES + header_len + CHECKSUM_BYTES) as u128
+        + pixels * (PIXEL_BYTES + 16 * stride) as u128
+        + splats as u128 * SPLAT_BYTES as u128;
     if (bytes.len() as u128) < expected {
         return Err(format!("truncated glint film ({} bytes, its header needs {expected})", bytes.len()));
     }
@@ -218,6 +235,13 @@ pub fn decode_film(bytes: &[u8]) -> Result<(Film, FilmMeta), String> {
     }
     let aov_bytes = take(n * stride * 16);
     let aov_sums = (0..n * stride).map(|k| i128_at(aov_bytes, k)).collect();
+    let splat_bytes = take(splats as usize * SPLAT_BYTES);
+    let splat = (0..splats as usize)
+        .map(|k| SplatSums {
+            sum: [i128_at(splat_bytes, 4 * k), i128_at(splat_bytes, 4 * k + 1), i128_at(splat_bytes, 4 * k + 2)],
+            weight: i128_at(splat_bytes, 4 * k + 3),
+        })
+        .collect();
     let film = Film::from_parts(FilmParts {
         width: header.width,
         height: header.height,
@@ -229,6 +253,8 @@ pub fn decode_film(bytes: &[u8]) -> Result<(Film, FilmMeta), String> {
         pixels: sums,
         aov_sums,
         converged,
+        filter: header.filter,
+        splat,
     })
     .map_err(|e| format!("inconsistent film: {e}"))?;
     Ok((film, FilmMeta { scene_hash: header.scene_hash, settings: header.settings }))
@@ -278,6 +304,26 @@ mod tests {
     }
 
     #[test]
+    fn a_splatting_film_round_trips_and_a_missing_splat_byte_is_an_error() {
+        let region = Rect { x0: 1, y0: 1, x1: 4, y1: 3 };
+        let filter = PixelFilter::Gaussian { stddev: 0.5 };
+        let mut f = Film::with_filter(6, 5, region, 1, 2, &[], filter).unwrap();
+        let splat = f.sums_mut().splat.unwrap();
+        assert_eq!(splat.rect, Rect { x0: 0, y0: 0, x1: 6, y1: 5 });
+        splat.splat(&filter, 2.3, 1.7, Rgb { r: 1.0, g: 2.0, b: 3.0 });
+        splat.splat(&filter, 3.9, 2.1, Rgb::splat(0.5));
+        f.record_block(Block { region, passes: 0..1 }).unwrap();
+        let bytes = encode_film(&f, &meta());
+        let (back, _) = decode_film(&bytes).unwrap();
+        assert_eq!(back, f);
+        assert_eq!(back.image().pixels, f.image().pixels);
+        // One splat pixel fewer than the header implies.
+        let mut short = bytes[..bytes.len() - 8 - 64].to_vec();
+        short.extend_from_slice(&content_hash(&short).to_le_bytes());
+        assert!(decode_film(&short).unwrap_err().contains("truncated"));
+    }
+
+    #[test]
     fn every_corrupted_byte_is_an_error() {
         let bytes = encode_film(&sample_film(), &meta());
         for i in 0..bytes.len() {
@@ -299,7 +345,7 @@ mod tests {
             assert!(err.contains("truncated") || err.contains("not a glint film"), "{len}: {err}");
         }
         let mut future = bytes.clone();
-        future[8..12].copy_from_slice(&2u32.to_le_bytes());
+        future[8..12].copy_from_slice(&(FORMAT_VERSION + 1).to_le_bytes());
         assert!(decode_film(&future).unwrap_err().contains("newer"));
         assert!(decode_film(b"P6\n1 1\n255\n....................").unwrap_err().contains("not a glint film"));
     }

@@ -14,12 +14,22 @@
 //! Pass `p` covers sample indices `[p * pass_spp, min((p + 1) * pass_spp, spp))`. The film
 //! records what it holds as [`Block`]s (a pixel region and a range of passes); merging
 //! refuses blocks that overlap, so no sample can be counted twice.
+//!
+//! A film made with a filter other than the box also keeps splat sums ([`super::splat`]) over
+//! its region grown by the filter's margin; its image is then the splatted one, while the
+//! per-pixel sums above (of the samples taken in each pixel) still give the variance, sample
+//! count and adaptive decisions.
 
 use super::aov::{Aov, AovImage};
+use super::splat::{splat_rect, SplatBuffer, SplatSums};
 use crate::io::Image;
 use crate::math::Rgb;
+use crate::sampling::PixelFilter;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
+
+/// Largest reconstruction filter radius (pixels) a film takes; the scene validation allows less.
+pub const MAX_FILTER_RADIUS: f32 = 64.0;
 
 /// Fractional bits of the fixed-point sums.
 pub const FIXED_POINT_BITS: u32 = 40;
@@ -165,6 +175,17 @@ pub struct Film {
     aov_sums: Vec<i128>,
     /// Pixels that adaptive sampling has stopped.
     converged: Vec<bool>,
+    filter: PixelFilter,
+    /// Splat sums when `filter` splats, over the region grown by its margin.
+    splat: Option<SplatBuffer>,
+}
+
+/// A film's sums, borrowed for rendering in place.
+pub(crate) struct FilmSumsMut<'a> {
+    pub pixels: &'a mut [PixelSums],
+    pub aov_sums: &'a mut [i128],
+    pub converged: &'a [bool],
+    pub splat: Option<&'a mut SplatBuffer>,
 }
 
 /// Everything a film holds, for checkpoints.
@@ -179,13 +200,33 @@ pub(crate) struct FilmParts {
     pub pixels: Vec<PixelSums>,
     pub aov_sums: Vec<i128>,
     pub converged: Vec<bool>,
+    pub filter: PixelFilter,
+    /// Splat sums (empty unless the filter splats).
+    pub splat: Vec<SplatSums>,
 }
 
 impl Film {
     /// An empty film over `region` of a `width`×`height` image. AOVs are kept in the order
     /// given, without repeats.
     pub fn new(width: u32, height: u32, region: Rect, pass_spp: u32, spp: u32, aovs: &[Aov]) -> Result<Film, String> {
+        Film::with_filter(width, height, region, pass_spp, spp, aovs, PixelFilter::Box)
+    }
+
+    /// An empty film whose image is reconstructed with `filter` (splatted unless the box).
+    pub fn with_filter(
+        width: u32,
+        height: u32,
+        region: Rect,
+        pass_spp: u32,
+        spp: u32,
+        aovs: &[Aov],
+        filter: PixelFilter,
+    ) -> Result<Film, String> {
         check_shape(width, height, region, pass_spp, spp, aovs)?;
+        let r = filter.radius();
+        if !(r > 0.0 && r <= MAX_FILTER_RADIUS) {
+            return Err(format!("filter radius {r} is outside (0, {MAX_FILTER_RADIUS}]"));
+        }
         let n = region.area() as usize;
         let stride: usize = aovs.iter().map(|a| a.stored_channels()).sum();
         Ok(Film {
@@ -199,14 +240,17 @@ impl Film {
             pixels: vec![PixelSums::default(); n],
             aov_sums: vec![0; n * stride],
             converged: vec![false; n],
+            filter,
+            splat: filter.splats().then(|| SplatBuffer::new(splat_rect(region, &filter, width, height))),
         })
     }
 
     pub(crate) fn from_parts(p: FilmParts) -> Result<Film, String> {
-        let mut film = Film::new(p.width, p.height, p.region, p.pass_spp, p.spp, &p.aovs)?;
+        let mut film = Film::with_filter(p.width, p.height, p.region, p.pass_spp, p.spp, &p.aovs, p.filter)?;
         if p.pixels.len() != film.pixels.len()
             || p.aov_sums.len() != film.aov_sums.len()
             || p.converged.len() != film.converged.len()
+            || p.splat.len() != film.splat.as_ref().map_or(0, |s| s.sums.len())
         {
             return Err("film sums do not match its region and AOVs".into());
         }
@@ -220,6 +264,9 @@ impl Film {
         film.pixels = p.pixels;
         film.aov_sums = p.aov_sums;
         film.converged = p.converged;
+        if let Some(s) = &mut film.splat {
+            s.sums = p.splat;
+        }
         Ok(film)
     }
 
@@ -235,7 +282,19 @@ impl Film {
             pixels: self.pixels.clone(),
             aov_sums: self.aov_sums.clone(),
             converged: self.converged.clone(),
+            filter: self.filter,
+            splat: self.splat.as_ref().map_or(Vec::new(), |s| s.sums.clone()),
         }
+    }
+
+    /// The reconstruction filter (the box keeps each sample in its pixel).
+    pub fn filter(&self) -> PixelFilter {
+        self.filter
+    }
+
+    /// Pixels that receive splats (none for the box filter).
+    pub fn splat_rect(&self) -> Option<Rect> {
+        self.splat.as_ref().map(|s| s.rect)
     }
 
     pub fn width(&self) -> u32 {
@@ -428,9 +487,15 @@ impl Film {
         self.converged[i] = true;
     }
 
-    /// The region's sums, row-major, and the adaptive flags, for rendering in place.
-    pub(crate) fn sums_mut(&mut self) -> (&mut [PixelSums], &mut [i128], &[bool]) {
-        (&mut self.pixels, &mut self.aov_sums, &self.converged)
+    /// The region's sums, row-major, the adaptive flags and the splat sums, for rendering
+    /// in place.
+    pub(crate) fn sums_mut(&mut self) -> FilmSumsMut<'_> {
+        FilmSumsMut {
+            pixels: &mut self.pixels,
+            aov_sums: &mut self.aov_sums,
+            converged: &self.converged,
+            splat: self.splat.as_mut(),
+        }
     }
 
     pub(crate) fn region_sums(&self) -> &[PixelSums] {
@@ -479,6 +544,7 @@ impl Film {
         same("samples per pixel", self.spp.to_string(), other.spp.to_string())?;
         let names = |f: &Film| f.aovs.iter().map(|a| a.name()).collect::<Vec<_>>().join(",");
         same("AOVs", format!("[{}]", names(self)), format!("[{}]", names(other)))?;
+        same("filters", format!("{:?}", self.filter), format!("{:?}", other.filter))?;
         for b in &other.blocks {
             if let Some(o) = self.blocks.iter().find(|o| o.overlaps(b)) {
                 return Err(format!("cannot merge films: both hold samples of {} and {}", describe(o), describe(b)));
@@ -486,7 +552,8 @@ impl Film {
         }
         let region = self.region.bounding(&other.region);
         if region != self.region {
-            let mut grown = Film::new(self.width, self.height, region, self.pass_spp, self.spp, &self.aovs)?;
+            let mut grown =
+                Film::with_filter(self.width, self.height, region, self.pass_spp, self.spp, &self.aovs, self.filter)?;
             grown.add_film_sums(self);
             grown.blocks = std::mem::take(&mut self.blocks);
             *self = grown;
@@ -500,6 +567,9 @@ impl Film {
     fn add_film_sums(&mut self, other: &Film) {
         let tile = TileSums { rect: other.region, pixels: other.pixels.clone(), aov_sums: other.aov_sums.clone() };
         self.add_tile(&tile);
+        if let (Some(mine), Some(theirs)) = (&mut self.splat, &other.splat) {
+            mine.add(theirs);
+        }
         let w = other.region.width() as usize;
         for (i, &c) in other.converged.iter().enumerate() {
             if c {
@@ -519,11 +589,16 @@ impl Film {
         }
     }
 
-    /// The mean of each pixel; black outside the region and where nothing was sampled.
+    /// The mean of each pixel (with a splatting filter, its weighted mean over the splats it
+    /// received); black outside the region and where nothing was sampled.
     pub fn image(&self) -> Image {
         let mut img = Image::new(self.width as usize, self.height as usize);
+        let w = self.width as usize;
         self.for_each_pixel(|j, s, _| {
-            let m = s.mean();
+            let m = match &self.splat {
+                Some(splat) => splat.get((j % w) as u32, (j / w) as u32).map_or([0.0; 3], |p| p.value()),
+                None => s.mean(),
+            };
             img.pixels[j] = Rgb { r: m[0] as f32, g: m[1] as f32, b: m[2] as f32 };
         });
         img

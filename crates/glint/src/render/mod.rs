@@ -8,6 +8,7 @@ mod aov;
 pub mod checkpoint;
 pub mod film;
 mod passes;
+pub mod splat;
 
 pub use crate::sampling::PixelFilter;
 pub use aov::{Aov, AovImage};
@@ -88,7 +89,8 @@ pub fn render(
 ) -> RenderOutput {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let spp = settings.spp.max(1);
-    let mut film = Film::new(w, h, Rect::full(w, h), spp, spp, &[]).expect("the camera has a valid resolution");
+    let mut film = Film::with_filter(w, h, Rect::full(w, h), spp, spp, &[], settings.filter)
+        .expect("the camera has a valid resolution and the filter a validated radius");
     let request = PassRequest { passes: 0..1, adaptive: None };
     let outcome = render_passes(scene, integrator, settings, &mut film, &request, &AtomicBool::new(false), progress)
         .expect("a new film takes its first pass");

@@ -3,6 +3,7 @@
 //! passes; with passes of one sample (the default) a cancel takes effect within one pass.
 
 use super::film::{to_fixed, Block, Film, PixelSums, Rect};
+use super::splat::{splat_margin, SplatBuffer};
 use super::{Aov, Progress, RenderSettings, RenderStats};
 use crate::integrators::{closest_hit_cost, first_hit, Counters, Integrator};
 use crate::math::Rgb;
@@ -11,6 +12,7 @@ use crate::world::World;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// Adaptive sampling: a pixel stops taking samples once the relative standard error of its
@@ -64,6 +66,13 @@ pub fn render_passes(
             scene.camera.height
         ));
     }
+    if settings.filter != film.filter() {
+        return Err(format!(
+            "the film was made for the {:?} filter but the render uses {:?}",
+            film.filter(),
+            settings.filter
+        ));
+    }
     if !request.passes.is_empty() {
         film.check_free(&Block { region: film.region(), passes: request.passes.clone() })?;
     }
@@ -108,7 +117,12 @@ fn render_pass(
     let layers: Vec<(Aov, usize)> =
         film.aovs().iter().filter_map(|&a| film.aov_offset(a).map(|off| (a, off))).collect();
     let band_pixels = (tile * region.width()) as usize;
-    let (pixels, aov_sums, converged) = film.sums_mut();
+    let filter = film.filter();
+    let sums = film.sums_mut();
+    let (pixels, aov_sums, converged) = (sums.pixels, sums.aov_sums, sums.converged);
+    // Bands splat into buffers of their own, added into the film's under this lock as each
+    // band ends: the sums are exact, so the order bands finish in does not matter.
+    let splat = sums.splat.map(Mutex::new);
     let bands = pixels.len().div_ceil(band_pixels);
     let aov_bands: Vec<&mut [i128]> = if stride == 0 {
         (0..bands).map(|_| <&mut [i128]>::default()).collect()
@@ -127,6 +141,8 @@ fn render_pass(
         wants_first_hit,
         stride,
         progress,
+        splat: splat.as_ref(),
+        filter,
     };
     pixels
         .par_chunks_mut(band_pixels)
@@ -169,6 +185,9 @@ struct PassJob<'a> {
     wants_first_hit: bool,
     stride: usize,
     progress: &'a dyn Progress,
+    /// The film's splat sums, when its filter splats.
+    splat: Option<&'a Mutex<&'a mut SplatBuffer>>,
+    filter: crate::sampling::PixelFilter,
 }
 
 impl PassJob<'_> {
@@ -177,6 +196,16 @@ impl PassJob<'_> {
         let w = self.region.width();
         let y1 = (y0 + self.tile).min(self.region.y1);
         let mut counts = TileCounts::default();
+        let mut band_splat = self.splat.map(|film_splat| {
+            let film_rect = film_splat.lock().unwrap_or_else(|e| e.into_inner()).rect;
+            let m = splat_margin(&self.filter);
+            SplatBuffer::new(Rect {
+                x0: film_rect.x0,
+                x1: film_rect.x1,
+                y0: y0.saturating_sub(m).max(film_rect.y0),
+                y1: y1.saturating_add(m).min(film_rect.y1),
+            })
+        });
         let mut x0 = self.region.x0;
         while x0 < self.region.x1 {
             let x1 = (x0 + self.tile).min(self.region.x1);
@@ -188,30 +217,46 @@ impl PassJob<'_> {
                         continue;
                     }
                     let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];
-                    self.pixel(x, y, &mut pixels[i], aov, &mut counts);
+                    self.pixel(x, y, &mut pixels[i], aov, band_splat.as_mut(), &mut counts);
                 }
             }
             let rays = counts.counters.rays + counts.counters.shadow_rays - rays_before;
             self.progress.advance(((x1 - x0) * (y1 - y0)) as u64, rays);
             x0 = x1;
         }
+        if let (Some(film_splat), Some(band_splat)) = (self.splat, &band_splat) {
+            film_splat.lock().unwrap_or_else(|e| e.into_inner()).add(band_splat);
+        }
         counts
     }
 
-    fn pixel(&self, x: u32, y: u32, sums: &mut PixelSums, aov_sums: &mut [i128], counts: &mut TileCounts) {
+    fn pixel(
+        &self,
+        x: u32,
+        y: u32,
+        sums: &mut PixelSums,
+        aov_sums: &mut [i128],
+        mut splat: Option<&mut SplatBuffer>,
+        counts: &mut TileCounts,
+    ) {
         let (scene, settings) = (self.scene, self.settings);
         let pixel = y as u64 * scene.camera.width as u64 + x as u64;
         for s in self.samples.clone() {
             let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
-            let off = settings.filter.sample(rng.next_2d());
+            // Uniform in the pixel; a splatting filter spreads the sample over its neighbours.
+            let u = rng.next_2d();
+            let (px, py) = (x as f32 + 0.5 + (u[0] - 0.5), y as f32 + 0.5 + (u[1] - 0.5));
             let lens = rng.next_2d();
-            let ray = scene.camera.generate_ray(x as f32 + 0.5 + off[0], y as f32 + 0.5 + off[1], lens);
+            let ray = scene.camera.generate_ray(px, py, lens);
             let mut l = self.integrator.li(scene, &ray, &mut rng, &mut counts.counters);
             if !l.is_finite() || l.r < 0.0 || l.g < 0.0 || l.b < 0.0 {
                 counts.discarded += 1;
                 l = Rgb::BLACK;
             }
             sums.add_sample(l);
+            if let Some(buffer) = splat.as_deref_mut() {
+                buffer.splat(&self.filter, px, py, l);
+            }
             counts.camera_rays += 1;
             if self.layers.is_empty() {
                 continue;

@@ -1,9 +1,7 @@
-//! Pixel reconstruction filters, applied by filter importance sampling: each camera sample's
-//! offset from the pixel centre is drawn from the filter itself, and every sample has weight
-//! one. The expected pixel value is the filtered image, and pixels stay independent, which
-//! keeps rendering deterministic and free of splatting races.
-
-use crate::math::PI;
+//! Pixel reconstruction filters. Camera samples are placed uniformly in their pixel; the box
+//! keeps each sample in its own pixel, and the others are splatted by the film
+//! (`render::splat`) over every pixel within their radius, weighted as Mitsuba weights them,
+//! each pixel dividing by the weights it received.
 
 #[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub enum PixelFilter {
@@ -12,34 +10,63 @@ pub enum PixelFilter {
     Box,
     /// Triangle of the given radius (pixels).
     Tent { radius: f32 },
-    /// Gaussian of the given standard deviation (pixels), truncated at 4 sigma... as
-    /// Mitsuba does (its radius is 4 stddev).
+    /// Gaussian of the given standard deviation (pixels), windowed at 4 standard deviations
+    /// as Mitsuba does.
     Gaussian { stddev: f32 },
 }
 
 impl PixelFilter {
-    /// Offset from the pixel centre, in pixels, for uniform `u`.
-    pub fn sample(&self, u: [f32; 2]) -> [f32; 2] {
+    /// Whether samples are splatted over neighbouring pixels (every filter but the box,
+    /// whose reach is the sample's own pixel).
+    pub fn splats(&self) -> bool {
+        !matches!(self, PixelFilter::Box)
+    }
+
+    /// Reach in pixels from a sample to the centres of the pixels it contributes to.
+    pub fn radius(&self) -> f32 {
         match *self {
-            PixelFilter::Box => [u[0] - 0.5, u[1] - 0.5],
-            PixelFilter::Tent { radius } => [sample_tent(u[0]) * radius, sample_tent(u[1]) * radius],
+            PixelFilter::Box => 0.5,
+            PixelFilter::Tent { radius } => radius,
+            PixelFilter::Gaussian { stddev } => 4.0 * stddev,
+        }
+    }
+
+    /// The 1D weight at offset `x` (pixels) from the sample, as Mitsuba's filters: the tent
+    /// `max(0, 1 - |x| / r)`, and the gaussian `exp(-x^2 / 2s^2)` less its value at the
+    /// radius (so that it reaches zero there), clamped at zero. Not normalised: pixels divide
+    /// by their summed weights.
+    pub fn eval(&self, x: f32) -> f32 {
+        match *self {
+            PixelFilter::Box => {
+                if x.abs() <= 0.5 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            PixelFilter::Tent { radius } => (1.0 - x.abs() / radius).max(0.0),
             PixelFilter::Gaussian { stddev } => {
-                // Box-Muller, rejected beyond the 4-sigma support by folding back into it.
-                let r = (-2.0 * (1.0 - u[0]).max(1e-12).ln()).sqrt();
-                let phi = 2.0 * PI * u[1];
-                let lim = 4.0;
-                let clamp = |v: f32| if v.abs() > lim { v % lim } else { v };
-                [clamp(r * phi.cos()) * stddev, clamp(r * phi.sin()) * stddev]
+                let alpha = -1.0 / (2.0 * stddev * stddev);
+                let r = 4.0 * stddev;
+                ((alpha * x * x).exp() - (alpha * r * r).exp()).max(0.0)
             }
         }
     }
 }
 
-/// Inverse CDF of the unit tent on [-1, 1].
-fn sample_tent(u: f32) -> f32 {
-    if u < 0.5 {
-        (2.0 * u).sqrt() - 1.0
-    } else {
-        1.0 - (2.0 - 2.0 * u).sqrt()
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_peak_at_zero_and_vanish_at_the_radius() {
+        for f in [PixelFilter::Tent { radius: 1.5 }, PixelFilter::Gaussian { stddev: 0.5 }] {
+            let r = f.radius();
+            assert!(f.eval(0.0) > 0.9 && f.eval(0.0) <= 1.0, "{f:?}");
+            assert!(f.eval(r).abs() < 1e-6 && f.eval(r * 1.01) == 0.0 && f.eval(-r * 1.5) == 0.0, "{f:?}");
+            assert_eq!(f.eval(0.3), f.eval(-0.3));
+            assert!(f.eval(0.2) > f.eval(0.6));
+            assert_eq!(f.eval(f32::NAN).max(0.0), 0.0);
+        }
     }
 }

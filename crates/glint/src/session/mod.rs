@@ -184,7 +184,8 @@ impl Session {
     pub fn new_film(&self, opts: &FilmOptions) -> Result<Film, Error> {
         let (w, h) = (self.desc.film.width, self.desc.film.height);
         let region = opts.region.unwrap_or(Rect::full(w, h));
-        Film::new(w, h, region, opts.pass_spp.unwrap_or(DEFAULT_PASS_SPP), self.desc.sampler.spp, &opts.aovs)
+        let pass_spp = opts.pass_spp.unwrap_or(DEFAULT_PASS_SPP);
+        Film::with_filter(w, h, region, pass_spp, self.desc.sampler.spp, &opts.aovs, self.desc.film.filter)
             .map_err(Error::new)
     }
 
@@ -382,8 +383,16 @@ impl PassJob<'_> {
             )));
         }
         for region in missing {
-            let mut part = Film::new(film.width(), film.height(), region, film.pass_spp(), film.spp(), film.aovs())
-                .map_err(Error::new)?;
+            let mut part = Film::with_filter(
+                film.width(),
+                film.height(),
+                region,
+                film.pass_spp(),
+                film.spp(),
+                film.aovs(),
+                film.filter(),
+            )
+            .map_err(Error::new)?;
             let outcome =
                 render_passes(self.world, self.integrator, self.settings, &mut part, &request, cancel, progress)
                     .map_err(Error::new)?;
