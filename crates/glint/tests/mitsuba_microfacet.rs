@@ -22,7 +22,7 @@ fn model(bsdf: &str) -> MaterialModel {
 
 fn error(bsdf: &str) -> String {
     let e = read_str(&scene(bsdf), Path::new("m.xml"), &[]).expect_err("should be rejected").to_string();
-    assert!(!e.contains('\n') && e.contains("m.xml:4:"), "one line naming the file and line: {e}");
+    assert!(!e.contains('\n') && e.contains("m.xml:5:"), "one line naming the file and line: {e}");
     e
 }
 

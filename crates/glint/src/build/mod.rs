@@ -100,12 +100,24 @@ fn roughness_map(r: &Roughness, textures: &mut TextureCache) -> Result<Roughness
             let mut tex = |s: &ScalarTexture| -> Result<Texture, Error> {
                 match s {
                     ScalarTexture::Value(v) => Ok(Texture::Constant(crate::math::Rgb::splat(*v))),
-                    ScalarTexture::Texture(t) => textures.texture(t),
+                    ScalarTexture::Texture(t) => Ok(scalar_checker_parity(textures.texture(t)?)),
                 }
             };
             RoughnessMap::Textured { kind: r.distribution, alpha_u: tex(alpha_u)?, alpha_v: tex(alpha_v)? }
         }
     })
+}
+
+/// Mitsuba's checkerboard read as a number (`eval_1`, what roughness reads) puts `color1`
+/// where its colour lookup (`eval`) puts `color0`, and the reverse; glint follows it, so a
+/// checkerboard of roughness lands where Mitsuba puts it.
+fn scalar_checker_parity(t: Texture) -> Texture {
+    match t {
+        Texture::Checkerboard { color0, color1, uv_scale, uv_offset } => {
+            Texture::Checkerboard { color0: color1, color1: color0, uv_scale, uv_offset }
+        }
+        other => other,
+    }
 }
 
 /// A roughness that must be one number (plastics, whose coating tables are precomputed).
