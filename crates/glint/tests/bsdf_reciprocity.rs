@@ -4,8 +4,8 @@
 //! (η(wo)/η(wi))² radiance scaling is what makes the two sides agree.
 
 use glint::bsdf::{
-    fresnel_dielectric, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams, Principled,
-    PrincipledInputs, PrincipledRates,
+    fresnel_dielectric, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong, PlasticParams,
+    Principled, PrincipledInputs, PrincipledRates,
 };
 use glint::math::{rgb, Rgb, Vec3};
 use glint::sampling::{warp, Rng};
@@ -13,6 +13,8 @@ use glint::sampling::{warp, Rng};
 fn bsdfs() -> Vec<(&'static str, Bsdf)> {
     let ggx = Microfacet::new(MicrofacetKind::Ggx, 0.3);
     let beckmann = Microfacet::new(MicrofacetKind::Beckmann, 0.4);
+    let ggx_aniso = Microfacet::anisotropic(MicrofacetKind::Ggx, 0.1, 0.5);
+    let beckmann_aniso = Microfacet::anisotropic(MicrofacetKind::Beckmann, 0.6, 0.15);
     let gold = (rgb(0.143, 0.375, 1.442), rgb(3.983, 2.386, 1.603));
     vec![
         ("diffuse", Bsdf::Diffuse { reflectance: rgb(0.8, 0.5, 0.2) }),
@@ -30,7 +32,40 @@ fn bsdfs() -> Vec<(&'static str, Bsdf)> {
             "rough dielectric Beckmann",
             Bsdf::RoughDielectric { dist: beckmann, eta: 1.33, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
         ),
+        (
+            "anisotropic rough conductor GGX",
+            Bsdf::RoughConductor { dist: ggx_aniso, eta: gold.0, k: gold.1, specular: Rgb::WHITE },
+        ),
+        (
+            "anisotropic rough conductor Beckmann",
+            Bsdf::RoughConductor { dist: beckmann_aniso, eta: gold.0, k: gold.1, specular: Rgb::WHITE },
+        ),
+        (
+            "anisotropic rough dielectric GGX",
+            Bsdf::RoughDielectric { dist: ggx_aniso, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+        ),
+        (
+            "anisotropic rough dielectric Beckmann",
+            Bsdf::RoughDielectric { dist: beckmann_aniso, eta: 1.33, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+        ),
+        (
+            "pplastic",
+            Bsdf::PPlastic(PPlasticParams {
+                diffuse: rgb(0.3, 0.2, 0.1),
+                specular: Rgb::WHITE,
+                eta: 1.49,
+                dist: beckmann_aniso,
+                specular_probability: 0.7,
+            }),
+        ),
         ("smooth plastic", Bsdf::Plastic(PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, None))),
+        (
+            "nonlinear rough plastic",
+            Bsdf::Plastic(PlasticParams {
+                nonlinear: true,
+                ..PlasticParams::new(rgb(0.9, 0.3, 0.1), Rgb::WHITE, 1.5, Some(beckmann))
+            }),
+        ),
         ("rough plastic", Bsdf::Plastic(PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, Some(ggx)))),
         ("principled, every lobe", principled(0.0)),
         ("principled with spec_trans", principled(0.6)),

@@ -7,8 +7,8 @@ mod common;
 use common::bsdf_check::{chi2_of, dir, draw_samples, integrate, BsdfCase, Integrals, Samples};
 use common::stats::{sidak, z_critical, FALSE_ALARM};
 use glint::bsdf::{
-    normal_map_frame, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, Phong, PlasticParams, Principled,
-    PrincipledInputs, PrincipledRates, ShadedBsdf,
+    normal_map_frame, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong, PlasticParams,
+    Principled, PrincipledInputs, PrincipledRates, ShadedBsdf,
 };
 use glint::math::vec3;
 use glint::math::{rgb, Rgb};
@@ -38,6 +38,15 @@ fn tilted(name: &str, bsdf: Bsdf, n: glint::math::Vec3, wo_deg: f32) -> BsdfCase
         bsdf: ShadedBsdf { bsdf, tilt },
         wo: dir(wo_deg),
         complete: false,
+    }
+}
+
+/// A case seen from polar angle `theta_deg` at azimuth `phi_deg` (for anisotropic lobes).
+fn azimuth_case(name: &str, bsdf: Bsdf, theta_deg: f32, phi_deg: f32) -> BsdfCase {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    let wo = glint::math::Vec3 { x: t.sin() * p.cos(), y: t.sin() * p.sin(), z: t.cos() };
+    BsdfCase {
+        name: format!("{name}, wo at {theta_deg}°, azimuth {phi_deg}°"), bsdf: bsdf.into(), wo, complete: false
     }
 }
 
@@ -79,6 +88,40 @@ fn cases() -> Vec<BsdfCase> {
             let b = Bsdf::RoughDielectric { dist, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE };
             v.push(case(&format!("rough dielectric {name}"), b, wo, false));
         }
+    }
+    // Anisotropic lobes, seen from azimuths off both axes (the lobe is not symmetric there).
+    let aniso = |kind, u, v| Microfacet::anisotropic(kind, u, v);
+    for (name, dist) in [
+        ("GGX 0.05x0.4", aniso(MicrofacetKind::Ggx, 0.05, 0.4)),
+        ("Beckmann 0.4x0.1", aniso(MicrofacetKind::Beckmann, 0.4, 0.1)),
+    ] {
+        for (theta, phi) in [(0.0, 0.0), (50.0, 30.0), (80.0, 120.0)] {
+            let b = Bsdf::RoughConductor { dist, eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+            v.push(azimuth_case(&format!("rough conductor {name}"), b, theta, phi));
+        }
+        for (theta, phi) in [(40.0, 60.0), (140.0, 200.0)] {
+            let b = Bsdf::RoughDielectric { dist, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE };
+            v.push(azimuth_case(&format!("rough dielectric {name}"), b, theta, phi));
+        }
+    }
+    for (theta, phi) in [(0.0, 0.0), (60.0, 45.0)] {
+        let p = PPlasticParams {
+            diffuse: rgb(0.05, 0.03, 0.1),
+            specular: Rgb::WHITE,
+            eta: 1.49,
+            dist: Microfacet::anisotropic(MicrofacetKind::Beckmann, 0.06, 0.2),
+            specular_probability: 0.94,
+        };
+        v.push(azimuth_case("pplastic Beckmann 0.06x0.2", Bsdf::PPlastic(p), theta, phi));
+    }
+    for wo in [0.0, 70.0] {
+        let p = PlasticParams { nonlinear: true, ..PlasticParams::new(rgb(0.9, 0.3, 0.1), Rgb::WHITE, 1.5, None) };
+        v.push(case("smooth nonlinear plastic", Bsdf::Plastic(p), wo, true));
+        let p = PlasticParams {
+            nonlinear: true,
+            ..PlasticParams::new(rgb(0.9, 0.3, 0.1), Rgb::WHITE, 1.5, Some(ggx(0.3)))
+        };
+        v.push(case("rough nonlinear plastic GGX 0.3", Bsdf::Plastic(p), wo, false));
     }
     for wo in [0.0, 70.0] {
         let p = PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, None);

@@ -1,5 +1,5 @@
 //! Light sampling, BSDF sampling and their MIS combination are three estimators of the same
-//! image: on a scene with glossy (GGX α = 0.2) and diffuse surfaces lit by a small and a
+//! image: on a scene with glossy (GGX α = 0.2, and an anisotropic 0.1 × 0.4 ball) and diffuse surfaces lit by a small and a
 //! large quad light and a small sphere light, their image means and 8×8-block means must
 //! agree pairwise within Šidák-corrected standard errors (independent seeds).
 
@@ -24,16 +24,16 @@ const SPP: u32 = 256;
 const LONG_SPP: u32 = 8192;
 const STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::Light, Strategy::Bsdf];
 
-fn glossy(b: &mut WorldBuilder, name: &str) -> u32 {
-    let dist = Microfacet::new(MicrofacetKind::Ggx, 0.2);
+fn glossy(b: &mut WorldBuilder, name: &str, dist: Microfacet) -> u32 {
     let (eta, k) = (rgb(0.2, 0.92, 1.1), rgb(3.9, 2.45, 2.14)); // copper
+    let dist = dist.into();
     b.add_material(Material::new(name, MaterialKind::RoughConductor { dist, eta, k, specular: Rgb::WHITE }, true))
 }
 
 fn scene() -> World {
     let mut b = WorldBuilder::new(BvhSplit::Sah);
-    let floor = glossy(&mut b, "floor");
-    let ball = glossy(&mut b, "ball");
+    let floor = glossy(&mut b, "floor", Microfacet::new(MicrofacetKind::Ggx, 0.2));
+    let ball = glossy(&mut b, "ball", Microfacet::anisotropic(MicrofacetKind::Ggx, 0.1, 0.4));
     let wall = diffuse(&mut b, "wall", Rgb::splat(0.6));
     let chalk = diffuse(&mut b, "chalk", rgb(0.7, 0.5, 0.3));
     let lamp = black(&mut b);

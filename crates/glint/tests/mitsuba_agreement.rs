@@ -263,3 +263,17 @@ fn principled_bsdf_under_an_environment_map() {
 fn blended_bsdfs_and_twosided_around_and_inside_a_blend() {
     check("blend");
 }
+
+/// Anisotropic GGX and Beckmann conductors on spheres and a rectangle (alpha_u along dp/du,
+/// as Mitsuba orients it), roughness from checkerboard textures on a conductor and a glass.
+#[test]
+fn anisotropic_and_textured_roughness() {
+    check("anisotropic");
+}
+
+/// Nonlinear smooth and rough plastics, an anisotropic pplastic and a polarizer sheet, as
+/// Mitsuba's RGB variants render them.
+#[test]
+fn nonlinear_plastics_pplastic_and_polarizer() {
+    check("plastics");
+}

@@ -87,10 +87,14 @@ pub enum Bsdf {
     Principled(Principled),
     /// Mitsuba's `blendbsdf`: a weighted mixture of two BSDFs.
     Blend(BlendBsdf),
+    /// Mitsuba's `pplastic` as its unpolarized variants render it.
+    PPlastic(PPlasticParams),
 }
 
 mod plastic;
+mod pplastic;
 pub use plastic::PlasticParams;
+pub use pplastic::PPlasticParams;
 
 impl Bsdf {
     /// True when every lobe is a delta: light sampling is pointless there.
@@ -138,6 +142,7 @@ impl Bsdf {
                 microfacet::eval_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
             }
             Bsdf::Plastic(p) => p.eval(wo, wi),
+            Bsdf::PPlastic(p) => p.eval(wo, wi),
             Bsdf::Principled(p) => p.eval(wo, wi),
             Bsdf::Blend(b) => b.eval(wo, wi),
             Bsdf::Conductor { .. }
@@ -171,6 +176,7 @@ impl Bsdf {
             Bsdf::Plastic(p) => p.pdf(wo, wi),
             Bsdf::Principled(p) => p.pdf(wo, wi),
             Bsdf::Blend(b) => b.pdf(wo, wi),
+            Bsdf::PPlastic(p) => p.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -242,6 +248,7 @@ impl Bsdf {
                 microfacet::sample_rough_dielectric(dist, *eta, *reflect, *transmit, wo, u_lobe, u)
             }
             Bsdf::Plastic(p) => p.sample(wo, u_lobe, u),
+            Bsdf::PPlastic(p) => p.sample(wo, u_lobe, u),
             Bsdf::Black => None,
             Bsdf::Null => Some(BsdfSample { wi: -wo, weight: Rgb::WHITE, pdf: 1.0, delta: true, eta: 1.0 }),
             Bsdf::Principled(p) => p.sample(wo, u_lobe, u),
@@ -258,6 +265,7 @@ impl Bsdf {
             Bsdf::Plastic(p) => p.diffuse,
             Bsdf::Principled(p) => p.diffuse_reflectance(),
             Bsdf::Blend(b) => b.diffuse_reflectance(),
+            Bsdf::PPlastic(p) => p.diffuse,
             _ => Rgb::BLACK,
         }
     }

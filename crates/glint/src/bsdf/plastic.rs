@@ -28,6 +28,10 @@ pub struct PlasticParams {
     /// Interned (see `rough_coating_tables`), so that the BSDF stays small: it is built by
     /// value at every hit.
     pub transmittance: Option<&'static [f32; TRANSMITTANCE_RES]>,
+    /// Mitsuba's `nonlinear`: each bounce inside the coating meets the base again, so the
+    /// series sums to ρ / (1 - ρ F_dr) rather than ρ / (1 - F_dr) (which assumes the light
+    /// reflected back down is not absorbed by the base).
+    pub nonlinear: bool,
 }
 
 pub const TRANSMITTANCE_RES: usize = 64;
@@ -105,7 +109,7 @@ impl PlasticParams {
                 (internal, Some(table))
             }
         };
-        PlasticParams { diffuse, specular, eta, dist, fdr_internal, transmittance }
+        PlasticParams { diffuse, specular, eta, dist, fdr_internal, transmittance, nonlinear: false }
     }
 
     /// Energy transmitted through the coating for direction cosine `cos`.
@@ -151,7 +155,11 @@ impl PlasticParams {
     fn diffuse_eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         let to = self.coating_transmittance(wo.z);
         let ti = self.coating_transmittance(wi.z);
-        let albedo = self.diffuse / (1.0 - self.fdr_internal);
+        let albedo = if self.nonlinear {
+            self.diffuse.map(|d| d / (1.0 - d * self.fdr_internal))
+        } else {
+            self.diffuse / (1.0 - self.fdr_internal)
+        };
         albedo * (INV_PI * wi.z * to * ti / (self.eta * self.eta))
     }
 

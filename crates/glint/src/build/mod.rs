@@ -17,13 +17,15 @@ use crate::accel::BvhSplit;
 use crate::bsdf::Microfacet;
 use crate::bsdf::PrincipledRates;
 use crate::camera::Camera;
+use crate::describe::ScalarTexture as DescScalar;
 use crate::describe::{
     CameraDesc, Geometry, LightKind, MaterialModel, MaterialRef, Matrix4, Roughness, SceneDesc, TextureDesc,
 };
 use crate::error::{Error, SourceLoc};
 use crate::lights::{Light, ProjectedKind, ProjectedLight};
 use crate::materials::{
-    Bitmap, BlendMaterial, BlendMaterialPart, Material, MaterialKind, PrincipledMaterial, ScalarTexture, Texture,
+    Bitmap, BlendMaterial, BlendMaterialPart, Material, MaterialKind, PrincipledMaterial, RoughnessMap, ScalarTexture,
+    Texture,
 };
 use crate::math::{Aabb, Frame, Mat4, Transform, Vec3};
 use crate::world::World;
@@ -94,8 +96,45 @@ impl TextureCache {
     }
 }
 
-fn microfacet(r: &Roughness) -> Microfacet {
-    Microfacet::new(r.distribution, r.alpha)
+/// The roughness of a material: constant, or read from its textures at each hit.
+fn roughness_map(r: &Roughness, textures: &mut TextureCache) -> Result<RoughnessMap, Error> {
+    let alpha_u = &r.alpha;
+    let alpha_v = r.alpha_v.as_ref().unwrap_or(alpha_u);
+    Ok(match (alpha_u, alpha_v) {
+        (DescScalar::Value(u), DescScalar::Value(v)) => {
+            RoughnessMap::Constant(Microfacet::anisotropic(r.distribution, *u, *v))
+        }
+        _ => {
+            let mut tex = |s: &DescScalar| -> Result<Texture, Error> {
+                match s {
+                    DescScalar::Value(v) => Ok(Texture::Constant(crate::math::Rgb::splat(*v))),
+                    DescScalar::Texture(t) => Ok(scalar_checker_parity(textures.texture(t)?)),
+                }
+            };
+            RoughnessMap::Textured { kind: r.distribution, alpha_u: tex(alpha_u)?, alpha_v: tex(alpha_v)? }
+        }
+    })
+}
+
+/// Mitsuba's checkerboard read as a number (`eval_1`, what roughness reads) puts `color1`
+/// where its colour lookup (`eval`) puts `color0`, and the reverse; glint follows it, so a
+/// checkerboard of roughness lands where Mitsuba puts it.
+fn scalar_checker_parity(t: Texture) -> Texture {
+    match t {
+        Texture::Checkerboard { color0, color1, uv_scale, uv_offset } => {
+            Texture::Checkerboard { color0: color1, color1: color0, uv_scale, uv_offset }
+        }
+        other => other,
+    }
+}
+
+/// A roughness that must be one number (plastics, whose coating tables are precomputed).
+fn constant_microfacet(r: &Roughness) -> Result<Microfacet, Error> {
+    match (&r.alpha, &r.alpha_v) {
+        (DescScalar::Value(a), None) => Ok(Microfacet::new(r.distribution, *a)),
+        (DescScalar::Value(a), Some(DescScalar::Value(b))) if a == b => Ok(Microfacet::new(r.distribution, *a)),
+        _ => Err(Error::new("this material's roughness must be one number (isotropic, untextured), as in Mitsuba")),
+    }
 }
 
 fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
@@ -106,18 +145,31 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
         }
         MaterialModel::Conductor { eta, k, specular, roughness } => match roughness {
             None => MaterialKind::Conductor { eta: *eta, k: *k, specular: *specular },
-            Some(r) => MaterialKind::RoughConductor { dist: microfacet(r), eta: *eta, k: *k, specular: *specular },
+            Some(r) => MaterialKind::RoughConductor {
+                dist: roughness_map(r, textures)?,
+                eta: *eta,
+                k: *k,
+                specular: *specular,
+            },
         },
         MaterialModel::Dielectric { eta, reflect, transmit, roughness, thin } => {
             let (eta, reflect, transmit) = (*eta, *reflect, *transmit);
             match (thin, roughness) {
                 (true, _) => MaterialKind::ThinDielectric { eta, reflect, transmit },
                 (false, None) => MaterialKind::Dielectric { eta, reflect, transmit },
-                (false, Some(r)) => MaterialKind::RoughDielectric { dist: microfacet(r), eta, reflect, transmit },
+                (false, Some(r)) => {
+                    MaterialKind::RoughDielectric { dist: roughness_map(r, textures)?, eta, reflect, transmit }
+                }
             }
         }
-        MaterialModel::Plastic { diffuse, specular, eta, roughness } => {
-            Material::plastic(textures.texture(diffuse)?, *specular, *eta, roughness.as_ref().map(microfacet))
+        MaterialModel::Plastic { diffuse, specular, eta, roughness, nonlinear } => {
+            let dist = roughness.as_ref().map(constant_microfacet).transpose()?;
+            let diffuse = textures.texture(diffuse)?;
+            if *nonlinear {
+                Material::nonlinear_plastic(diffuse, *specular, *eta, dist)
+            } else {
+                Material::plastic(diffuse, *specular, *eta, dist)
+            }
         }
         MaterialModel::Black => MaterialKind::Black,
         MaterialModel::NormalMap { normals, nested } => MaterialKind::NormalMap {
@@ -141,6 +193,18 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
             };
             let (first, second) = (part(&b.first)?, part(&b.second)?);
             MaterialKind::Blend(BlendMaterial::new(ScalarTexture::new(textures.texture(&b.weight)?), first, second))
+        }
+        MaterialModel::PPlastic { diffuse, specular, eta, roughness } => {
+            let diffuse = textures.texture(diffuse)?;
+            let (d, s) = (diffuse.mean().average(), specular.average());
+            let specular_probability = if d + s > 0.0 { s / (d + s) } else { 0.5 };
+            MaterialKind::PPlastic {
+                diffuse,
+                specular: *specular,
+                eta: *eta,
+                dist: roughness_map(roughness, textures)?,
+                specular_probability,
+            }
         }
     })
 }

@@ -172,12 +172,18 @@ fn material(m: &MaterialModel) -> Result<(), String> {
         }
     }
     let alpha = |r: &Option<crate::describe::Roughness>| -> Result<(), String> {
-        match r {
-            Some(r) if !(r.alpha > 0.0 && r.alpha.is_finite()) => {
-                Err(format!("roughness alpha {} must be positive and finite", r.alpha))
+        let Some(r) = r else { return Ok(()) };
+        // A constant alpha must be positive (0 is a smooth surface, described as such); a
+        // textured one may reach 0 where it is checked as a colour, and is clamped, as
+        // Mitsuba clamps it, to 1e-4.
+        for (name, value) in [("alpha", Some(&r.alpha)), ("alpha_v", r.alpha_v.as_ref())] {
+            if let Some(crate::describe::ScalarTexture::Value(a)) = value {
+                if !(*a > 0.0 && a.is_finite()) {
+                    return Err(format!("roughness {name} {a} must be positive and finite"));
+                }
             }
-            _ => Ok(()),
         }
+        Ok(())
     };
     let eta_ok = |eta: f32| -> Result<(), String> {
         if eta > 0.0 && eta.is_finite() {
@@ -209,6 +215,11 @@ fn material(m: &MaterialModel) -> Result<(), String> {
             eta_ok(*eta)?;
             color(*specular, "specular reflectance")?;
             alpha(roughness)?;
+        }
+        MaterialModel::PPlastic { specular, eta, roughness, .. } => {
+            eta_ok(*eta)?;
+            color(*specular, "specular reflectance")?;
+            alpha(&Some(roughness.clone()))?;
         }
         MaterialModel::Diffuse { .. } | MaterialModel::Black | MaterialModel::Null => {}
         MaterialModel::BumpMap { scale, nested, .. } => {

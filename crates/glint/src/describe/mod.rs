@@ -117,10 +117,52 @@ pub struct MaterialDesc {
     pub loc: SourceLoc,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// A microfacet roughness. `alpha` runs along the surface's dp/du (Mitsuba's `alpha_u`);
+/// `alpha_v`, along dp/dv, makes it anisotropic, and is `alpha` when absent.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Roughness {
     pub distribution: MicrofacetKind,
-    pub alpha: f32,
+    pub alpha: ScalarTexture,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_v: Option<ScalarTexture>,
+}
+
+impl Roughness {
+    pub fn isotropic(distribution: MicrofacetKind, alpha: f32) -> Roughness {
+        Roughness { distribution, alpha: ScalarTexture::Value(alpha), alpha_v: None }
+    }
+
+    /// The roughness values that are textures.
+    pub fn textures(&self) -> Vec<&TextureDesc> {
+        self.alpha_v.iter().chain([&self.alpha]).filter_map(ScalarTexture::texture).collect()
+    }
+
+    pub fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        let v = self.alpha_v.iter_mut().chain([&mut self.alpha]);
+        v.filter_map(|s| match s {
+            ScalarTexture::Texture(t) => Some(t),
+            ScalarTexture::Value(_) => None,
+        })
+        .collect()
+    }
+}
+
+/// A number, or a texture read as one (its luminance, as Mitsuba's `eval_1`). In JSON a
+/// plain number or a texture object.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ScalarTexture {
+    Value(f32),
+    Texture(TextureDesc),
+}
+
+impl ScalarTexture {
+    pub fn texture(&self) -> Option<&TextureDesc> {
+        match self {
+            ScalarTexture::Texture(t) => Some(t),
+            ScalarTexture::Value(_) => None,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -154,6 +196,10 @@ pub enum MaterialModel {
         specular: Rgb,
         eta: f32,
         roughness: Option<Roughness>,
+        /// Mitsuba's `nonlinear`: the internal scattering series divides the albedo ρ by
+        /// 1 - ρ F_dr instead of 1 - F_dr, which darkens and saturates colours.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        nonlinear: bool,
     },
     /// Absorbs everything (emitters without a material).
     Black,
@@ -179,6 +225,14 @@ pub enum MaterialModel {
     Principled(PrincipledDesc),
     /// Mitsuba's `blendbsdf`.
     Blend(BlendDesc),
+    /// Mitsuba's `pplastic` as its unpolarized variants render it: a rough specular lobe
+    /// over a diffuse base attenuated by Fresnel transmission in and out.
+    PPlastic {
+        diffuse: TextureDesc,
+        specular: Rgb,
+        eta: f32,
+        roughness: Roughness,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -487,15 +541,20 @@ impl SceneDesc {
 }
 
 impl MaterialModel {
+    /// Every texture of the material, colours and roughness maps alike.
     pub fn textures(&self) -> Vec<&TextureDesc> {
+        fn rough(r: &Option<Roughness>) -> Vec<&TextureDesc> {
+            r.as_ref().map_or(Vec::new(), Roughness::textures)
+        }
         match self {
             MaterialModel::Diffuse { reflectance } => vec![reflectance],
             MaterialModel::Phong { kd, .. } => vec![kd],
-            MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
-            MaterialModel::Conductor { .. }
-            | MaterialModel::Dielectric { .. }
-            | MaterialModel::Black
-            | MaterialModel::Null => vec![],
+            MaterialModel::Plastic { diffuse, roughness, .. } => [vec![diffuse], rough(roughness)].concat(),
+            MaterialModel::Conductor { roughness, .. } | MaterialModel::Dielectric { roughness, .. } => {
+                rough(roughness)
+            }
+            MaterialModel::Black | MaterialModel::Null => vec![],
+            MaterialModel::PPlastic { diffuse, roughness, .. } => [vec![diffuse], roughness.textures()].concat(),
             MaterialModel::NormalMap { normals: t, nested }
             | MaterialModel::BumpMap { height: t, nested, .. }
             | MaterialModel::Mask { opacity: t, nested } => {
@@ -514,14 +573,21 @@ impl MaterialModel {
     }
 
     pub fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        fn rough(r: &mut Option<Roughness>) -> Vec<&mut TextureDesc> {
+            r.as_mut().map_or(Vec::new(), Roughness::textures_mut)
+        }
         match self {
             MaterialModel::Diffuse { reflectance } => vec![reflectance],
             MaterialModel::Phong { kd, .. } => vec![kd],
-            MaterialModel::Plastic { diffuse, .. } => vec![diffuse],
-            MaterialModel::Conductor { .. }
-            | MaterialModel::Dielectric { .. }
-            | MaterialModel::Black
-            | MaterialModel::Null => vec![],
+            MaterialModel::Plastic { diffuse, roughness, .. } => {
+                let mut v = vec![diffuse];
+                v.extend(rough(roughness));
+                v
+            }
+            MaterialModel::Conductor { roughness, .. } | MaterialModel::Dielectric { roughness, .. } => {
+                rough(roughness)
+            }
+            MaterialModel::Black | MaterialModel::Null => vec![],
             MaterialModel::NormalMap { normals: t, nested }
             | MaterialModel::BumpMap { height: t, nested, .. }
             | MaterialModel::Mask { opacity: t, nested } => {
@@ -534,6 +600,11 @@ impl MaterialModel {
                 let mut v = vec![&mut b.weight];
                 v.extend(b.first.model.textures_mut());
                 v.extend(b.second.model.textures_mut());
+                v
+            }
+            MaterialModel::PPlastic { diffuse, roughness, .. } => {
+                let mut v = vec![diffuse];
+                v.extend(roughness.textures_mut());
                 v
             }
         }

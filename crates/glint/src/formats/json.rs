@@ -11,7 +11,7 @@ use crate::describe::{BlendDesc, BlendPartDesc, PrincipledDesc};
 use crate::describe::{
     CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
     MaterialModel, MaterialRef, Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc,
-    SceneDesc, ShapeDesc, ShapeMedia, Strategy, TextureDesc, VolpathSettings, WhittedSettings,
+    ScalarTexture, SceneDesc, ShapeDesc, ShapeMedia, Strategy, TextureDesc, VolpathSettings, WhittedSettings,
 };
 use crate::error::{Error, SourceLoc};
 use crate::lights::LightSelection;
@@ -229,7 +229,9 @@ enum JsonMaterial {
         #[serde(default)]
         specular: Option<JsonColor>,
         #[serde(default)]
-        alpha: Option<f32>,
+        alpha: Option<JsonTexture>,
+        #[serde(default)]
+        alpha_v: Option<JsonTexture>,
         #[serde(default)]
         distribution: Option<String>,
     },
@@ -237,7 +239,9 @@ enum JsonMaterial {
         #[serde(default)]
         ior: Option<f32>,
         #[serde(default)]
-        alpha: Option<f32>,
+        alpha: Option<JsonTexture>,
+        #[serde(default)]
+        alpha_v: Option<JsonTexture>,
         #[serde(default)]
         distribution: Option<String>,
         #[serde(default)]
@@ -251,6 +255,27 @@ enum JsonMaterial {
         alpha: Option<f32>,
         #[serde(default)]
         distribution: Option<String>,
+        #[serde(default)]
+        nonlinear: bool,
+    },
+    /// Mitsuba's `pplastic` as its RGB variants render it.
+    Pplastic {
+        diffuse: JsonTexture,
+        #[serde(default)]
+        specular: Option<JsonColor>,
+        #[serde(default)]
+        ior: Option<f32>,
+        #[serde(default)]
+        alpha: Option<JsonTexture>,
+        #[serde(default)]
+        alpha_v: Option<JsonTexture>,
+        #[serde(default)]
+        distribution: Option<String>,
+    },
+    /// Mitsuba's `polarizer` on unpolarized light: passes half of `transmittance`.
+    Polarizer {
+        #[serde(default)]
+        transmittance: Option<JsonColor>,
     },
     /// `material` shaded with a tangent-space normal map.
     NormalMap { normals: JsonTexture, material: Box<JsonMaterial> },
@@ -492,8 +517,31 @@ fn texture_of(ctx: &Ctx, json_path: &str, t: &JsonTexture) -> TextureDesc {
     }
 }
 
-fn roughness(ctx: &Ctx, at: &str, name: &Option<String>, alpha: Option<f32>) -> Result<Option<Roughness>, Error> {
-    let Some(alpha) = alpha.filter(|a| *a > 0.0 || a.is_nan()) else { return Ok(None) };
+/// A roughness from `alpha` (a number or a texture; along dp/du when `alpha_v` is given).
+/// A constant `alpha` of 0 or less with no `alpha_v` means a smooth surface.
+fn roughness(
+    ctx: &Ctx,
+    at: &str,
+    name: &Option<String>,
+    alpha: &Option<JsonTexture>,
+    alpha_v: &Option<JsonTexture>,
+) -> Result<Option<Roughness>, Error> {
+    let scalar = |field: &str, t: &JsonTexture| match texture_of(ctx, &format!("{at}/{field}"), t) {
+        TextureDesc::Constant { color } if color.r == color.g && color.g == color.b => ScalarTexture::Value(color.r),
+        other => ScalarTexture::Texture(other),
+    };
+    let Some(alpha) = alpha.as_ref().map(|a| scalar("alpha", a)) else {
+        if alpha_v.is_some() {
+            return Err(ctx.err(&format!("{at}/alpha_v"), "alpha_v needs alpha (the roughness along u) too"));
+        }
+        return Ok(None);
+    };
+    let alpha_v = alpha_v.as_ref().map(|a| scalar("alpha_v", a));
+    if let (ScalarTexture::Value(a), None) = (&alpha, &alpha_v) {
+        if !(*a > 0.0 || a.is_nan()) {
+            return Ok(None);
+        }
+    }
     let distribution = match name.as_deref().unwrap_or("ggx") {
         "ggx" => MicrofacetKind::Ggx,
         "beckmann" => MicrofacetKind::Beckmann,
@@ -504,7 +552,7 @@ fn roughness(ctx: &Ctx, at: &str, name: &Option<String>, alpha: Option<f32>) -> 
             ))
         }
     };
-    Ok(Some(Roughness { distribution, alpha }))
+    Ok(Some(Roughness { distribution, alpha, alpha_v }))
 }
 
 fn material_of(ctx: &Ctx, name: &str, m: &JsonMaterial) -> Result<MaterialDesc, Error> {
@@ -572,37 +620,74 @@ fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(
             },
             true,
         ),
-        JsonMaterial::Conductor { metal, eta, k, specular, alpha, distribution } => {
+        JsonMaterial::Conductor { metal, eta, k, specular, alpha, alpha_v, distribution } => {
             let (e, kk) = match (metal, eta, k) {
                 (Some(mname), None, None) => conductor_preset(mname).ok_or_else(|| {
-                    ctx.err(&format!("{at}/metal"), format!("unknown metal '{mname}' (Au, Ag, Cu, Al, Cr)"))
+                    ctx.err(
+                        &format!("{at}/metal"),
+                        format!("unknown metal '{mname}' (Mitsuba's conductor presets, e.g. Au, Ag, Cu, Al, Cr)"),
+                    )
                 })?,
                 (None, Some(e), Some(k)) => (e.rgb(), k.rgb()),
                 (None, None, None) => (Rgb::BLACK, Rgb::WHITE),
                 _ => return Err(ctx.err(&at, format!("material '{name}': give either 'metal' or both 'eta' and 'k'"))),
             };
             let specular = specular.map_or(Rgb::WHITE, |c| c.rgb());
-            let roughness = roughness(ctx, &at, distribution, *alpha)?;
+            let roughness = roughness(ctx, &at, distribution, alpha, alpha_v)?;
             (MaterialModel::Conductor { eta: e, k: kk, specular, roughness }, true)
         }
-        JsonMaterial::Dielectric { ior, alpha, distribution, thin } => {
+        JsonMaterial::Dielectric { ior, alpha, alpha_v, distribution, thin } => {
             let eta = ior.unwrap_or(1.5);
-            let roughness = if *thin { None } else { roughness(ctx, &at, distribution, *alpha)? };
+            let roughness = if *thin { None } else { roughness(ctx, &at, distribution, alpha, alpha_v)? };
             (
                 MaterialModel::Dielectric { eta, reflect: Rgb::WHITE, transmit: Rgb::WHITE, roughness, thin: *thin },
                 false,
             )
         }
-        JsonMaterial::Plastic { diffuse, ior, alpha, distribution } => (
+        JsonMaterial::Plastic { diffuse, ior, alpha, distribution, nonlinear } => (
             MaterialModel::Plastic {
                 diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
                 specular: Rgb::WHITE,
                 eta: ior.unwrap_or(1.49),
-                roughness: roughness(ctx, &at, distribution, *alpha)?,
+                // Plastics are isotropic with a constant roughness, as in Mitsuba.
+                roughness: roughness(
+                    ctx,
+                    &at,
+                    distribution,
+                    &alpha.map(|a| JsonTexture::Color(JsonColor::Grey(a))),
+                    &None,
+                )?,
+                nonlinear: *nonlinear,
             },
             true,
         ),
         JsonMaterial::Null {} => (MaterialModel::Null, false),
+        JsonMaterial::Pplastic { diffuse, specular, ior, alpha, alpha_v, distribution } => {
+            // Mitsuba's defaults: Beckmann, alpha 0.1.
+            let alpha = alpha.clone().or(Some(JsonTexture::Color(JsonColor::Grey(0.1))));
+            let name = distribution.clone().or(Some("beckmann".into()));
+            let roughness = roughness(ctx, &at, &name, &alpha, alpha_v)?
+                .ok_or_else(|| ctx.err(&format!("{at}/alpha"), "pplastic needs a positive alpha"))?;
+            (
+                MaterialModel::PPlastic {
+                    diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
+                    specular: specular.map_or(Rgb::WHITE, |c| c.rgb()),
+                    eta: ior.unwrap_or(1.49),
+                    roughness,
+                },
+                true,
+            )
+        }
+        JsonMaterial::Polarizer { transmittance } => (
+            MaterialModel::Dielectric {
+                eta: 1.0,
+                reflect: Rgb::BLACK,
+                transmit: transmittance.map_or(Rgb::WHITE, |c| c.rgb()) * 0.5,
+                roughness: None,
+                thin: true,
+            },
+            false,
+        ),
         JsonMaterial::Principled(p) => principled_of(ctx, &at, p)?,
         JsonMaterial::Blend { weight, materials, two_sided } => {
             let part = |i: usize| -> Result<Box<BlendPartDesc>, Error> {

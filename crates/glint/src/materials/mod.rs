@@ -3,13 +3,15 @@
 
 mod conductor_presets;
 mod principled_blend;
+mod roughness;
 mod surface;
 mod texture;
 pub use principled_blend::{BlendMaterial, BlendMaterialPart, PrincipledMaterial, ScalarTexture};
+pub use roughness::RoughnessMap;
 pub use surface::Perturbation;
 pub use texture::{Bitmap, Texture, TexturePoint};
 
-use crate::bsdf::{Bsdf, Microfacet, Phong, PlasticParams};
+use crate::bsdf::{Bsdf, Microfacet, PPlasticParams, Phong, PlasticParams};
 use crate::math::Rgb;
 
 #[derive(Clone, Debug)]
@@ -29,7 +31,7 @@ pub enum MaterialKind {
         specular: Rgb,
     },
     RoughConductor {
-        dist: Microfacet,
+        dist: RoughnessMap,
         eta: Rgb,
         k: Rgb,
         specular: Rgb,
@@ -40,7 +42,7 @@ pub enum MaterialKind {
         transmit: Rgb,
     },
     RoughDielectric {
-        dist: Microfacet,
+        dist: RoughnessMap,
         eta: f32,
         reflect: Rgb,
         transmit: Rgb,
@@ -81,6 +83,14 @@ pub enum MaterialKind {
     Principled(PrincipledMaterial),
     /// Mitsuba's `blendbsdf` of two material kinds.
     Blend(BlendMaterial),
+    /// Mitsuba's `pplastic` (unpolarized); `specular_probability` is fixed per material.
+    PPlastic {
+        diffuse: Texture,
+        specular: Rgb,
+        eta: f32,
+        dist: RoughnessMap,
+        specular_probability: f32,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -99,6 +109,12 @@ impl Material {
 
     pub fn plastic(diffuse: Texture, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> MaterialKind {
         MaterialKind::Plastic { diffuse, params: PlasticParams::new(Rgb::BLACK, specular, eta, dist) }
+    }
+
+    /// [`Material::plastic`] with Mitsuba's `nonlinear` internal scattering.
+    pub fn nonlinear_plastic(diffuse: Texture, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> MaterialKind {
+        let params = PlasticParams { nonlinear: true, ..PlasticParams::new(Rgb::BLACK, specular, eta, dist) };
+        MaterialKind::Plastic { diffuse, params }
     }
 
     /// True for materials that let light through (both faces are meaningful).
@@ -149,7 +165,7 @@ impl MaterialKind {
             MaterialKind::Dielectric { transmit, .. }
             | MaterialKind::RoughDielectric { transmit, .. }
             | MaterialKind::ThinDielectric { transmit, .. } => *transmit,
-            MaterialKind::Plastic { diffuse, .. } => diffuse.eval(uv),
+            MaterialKind::Plastic { diffuse, .. } | MaterialKind::PPlastic { diffuse, .. } => diffuse.eval(uv),
             MaterialKind::Null => Rgb::WHITE,
             MaterialKind::Principled(p) => p.base_color.eval(uv),
             MaterialKind::Blend(b) => b.albedo(uv),
@@ -174,13 +190,13 @@ impl MaterialKind {
             }
             MaterialKind::Conductor { eta, k, specular } => Bsdf::Conductor { eta: *eta, k: *k, specular: *specular },
             MaterialKind::RoughConductor { dist, eta, k, specular } => {
-                Bsdf::RoughConductor { dist: *dist, eta: *eta, k: *k, specular: *specular }
+                Bsdf::RoughConductor { dist: dist.at(p.uv), eta: *eta, k: *k, specular: *specular }
             }
             MaterialKind::Dielectric { eta, reflect, transmit } => {
                 Bsdf::Dielectric { eta: *eta, reflect: *reflect, transmit: *transmit }
             }
             MaterialKind::RoughDielectric { dist, eta, reflect, transmit } => {
-                Bsdf::RoughDielectric { dist: *dist, eta: *eta, reflect: *reflect, transmit: *transmit }
+                Bsdf::RoughDielectric { dist: dist.at(p.uv), eta: *eta, reflect: *reflect, transmit: *transmit }
             }
             MaterialKind::ThinDielectric { eta, reflect, transmit } => {
                 Bsdf::ThinDielectric { eta: *eta, reflect: *reflect, transmit: *transmit }
@@ -195,6 +211,15 @@ impl MaterialKind {
             MaterialKind::Null => Bsdf::Null,
             MaterialKind::Principled(pr) => Bsdf::Principled(pr.bsdf(p.uv)),
             MaterialKind::Blend(b) => b.bsdf(p.uv),
+            MaterialKind::PPlastic { diffuse, specular, eta, dist, specular_probability } => {
+                Bsdf::PPlastic(PPlasticParams {
+                    diffuse: diffuse.eval_at(p),
+                    specular: *specular,
+                    eta: *eta,
+                    dist: dist.at(p.uv),
+                    specular_probability: *specular_probability,
+                })
+            }
         }
     }
 }

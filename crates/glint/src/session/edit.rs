@@ -13,7 +13,7 @@
 
 use super::Session;
 use crate::build::{patch_appearance, BuildCounters};
-use crate::describe::{limits, LightKind, MaterialModel, Matrix4, Roughness, SceneDesc, TextureDesc};
+use crate::describe::{limits, LightKind, MaterialModel, Matrix4, Roughness, ScalarTexture, SceneDesc, TextureDesc};
 use crate::error::Error;
 use crate::math::Rgb;
 use std::sync::Arc;
@@ -88,7 +88,17 @@ enum Effect {
 
 fn roughness_slots<'a>(r: &'a mut Option<Roughness>, out: &mut Vec<(&'static str, Slot<'a>)>) {
     if let Some(r) = r {
-        out.push(("alpha", Slot::Float(&mut r.alpha)));
+        roughness_value_slots(r, out);
+    }
+}
+
+/// The constant roughness values (textured ones are not edited in place).
+fn roughness_value_slots<'a>(r: &'a mut Roughness, out: &mut Vec<(&'static str, Slot<'a>)>) {
+    if let ScalarTexture::Value(a) = &mut r.alpha {
+        out.push(("alpha", Slot::Float(a)));
+    }
+    if let Some(ScalarTexture::Value(a)) = &mut r.alpha_v {
+        out.push(("alpha_v", Slot::Float(a)));
     }
 }
 
@@ -119,11 +129,17 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
             out.push(("transmit", Slot::Color(transmit)));
             roughness_slots(roughness, &mut out);
         }
-        MaterialModel::Plastic { diffuse, specular, eta, roughness } => {
+        MaterialModel::Plastic { diffuse, specular, eta, roughness, .. } => {
             texture_slot("diffuse", diffuse, &mut out);
             out.push(("specular", Slot::Color(specular)));
             out.push(("eta", Slot::Float(eta)));
             roughness_slots(roughness, &mut out);
+        }
+        MaterialModel::PPlastic { diffuse, specular, eta, roughness } => {
+            texture_slot("diffuse", diffuse, &mut out);
+            out.push(("specular", Slot::Color(specular)));
+            out.push(("eta", Slot::Float(eta)));
+            roughness_value_slots(roughness, &mut out);
         }
         MaterialModel::Black | MaterialModel::Null => {}
         // The wrapped material's parameters, and a mask's constant opacity.

@@ -64,7 +64,7 @@ pub fn rough_mirror(b: &mut WorldBuilder, name: &str, alpha: f32) -> u32 {
     b.add_material(Material::new(
         name,
         MaterialKind::RoughConductor {
-            dist: Microfacet::new(MicrofacetKind::Ggx, alpha),
+            dist: Microfacet::new(MicrofacetKind::Ggx, alpha).into(),
             eta: Rgb::BLACK,
             k: Rgb::WHITE,
             specular: Rgb::WHITE,

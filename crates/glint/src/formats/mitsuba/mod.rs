@@ -7,8 +7,10 @@
 mod bsdfs_extra;
 mod instances;
 mod media;
+mod polarized;
 mod projected;
 mod props;
+mod roughness;
 mod spectrum;
 mod surface;
 pub mod xml;
@@ -26,6 +28,7 @@ use crate::materials::conductor_preset;
 use crate::math::{Rgb, Transform, Vec3};
 use crate::sampling::{PixelFilter, SamplerKind};
 use props::{color_of, Props};
+use roughness::RoughnessInput;
 use spectrum::SpectrumUse;
 use std::collections::HashMap;
 use std::path::Path;
@@ -367,23 +370,6 @@ impl<'a> Reader<'a> {
         }
     }
 
-    fn roughness(&self, p: &Props) -> Result<Roughness, Error> {
-        let distribution = match p.string("distribution").unwrap_or("beckmann") {
-            "beckmann" => MicrofacetKind::Beckmann,
-            "ggx" => MicrofacetKind::Ggx,
-            other => return Err(p.el.err(format!("unknown microfacet distribution '{other}'"))),
-        };
-        let alpha = match (p.opt_float("alpha_u")?, p.opt_float("alpha_v")?) {
-            (Some(u), Some(v)) if (u - v).abs() > 1e-6 => {
-                return Err(p.el.err("anisotropic roughness (alpha_u != alpha_v) is not supported"))
-            }
-            (Some(u), _) => u,
-            _ => p.float("alpha", 0.1)?,
-        };
-        let _ = p.bool("sample_visible", true)?;
-        Ok(Roughness { distribution, alpha })
-    }
-
     fn conductor_ior(&self, p: &Props) -> Result<(Rgb, Rgb), Error> {
         let (eta_el, k_el) = (p.find("eta"), p.find("k"));
         if eta_el.is_some() || k_el.is_some() {
@@ -432,7 +418,8 @@ impl<'a> Reader<'a> {
             "normalmap" | "bumpmap" | "mask" => return self.surface_material(el, ty),
             "diffuse" => MaterialModel::Diffuse { reflectance: self.texture(&p, "reflectance", Rgb::splat(0.5))? },
             "conductor" | "roughconductor" => {
-                let roughness = if ty == "roughconductor" { Some(self.roughness(&p)?) } else { None };
+                let roughness =
+                    if ty == "roughconductor" { Some(self.roughness(&p, RoughnessInput::Textured)?) } else { None };
                 let (eta, k) = self.conductor_ior(&p)?;
                 MaterialModel::Conductor { eta, k, specular: p.rgb("specular_reflectance", Rgb::WHITE)?, roughness }
             }
@@ -440,23 +427,28 @@ impl<'a> Reader<'a> {
                 let eta = self.ior(&p, "int_ior", 1.5046)? / self.ior(&p, "ext_ior", 1.000277)?;
                 let reflect = p.rgb("specular_reflectance", Rgb::WHITE)?;
                 let transmit = p.rgb("specular_transmittance", Rgb::WHITE)?;
-                let roughness = if ty == "roughdielectric" { Some(self.roughness(&p)?) } else { None };
+                let roughness =
+                    if ty == "roughdielectric" { Some(self.roughness(&p, RoughnessInput::Textured)?) } else { None };
                 MaterialModel::Dielectric { eta, reflect, transmit, roughness, thin: ty == "thindielectric" }
             }
             "plastic" | "roughplastic" => {
                 let eta = self.ior(&p, "int_ior", 1.49)? / self.ior(&p, "ext_ior", 1.000277)?;
                 let diffuse = self.texture(&p, "diffuse_reflectance", Rgb::splat(0.5))?;
                 let specular = p.rgb("specular_reflectance", Rgb::WHITE)?;
-                if p.bool("nonlinear", false)? {
-                    return Err(el.err(format!("{ty}: nonlinear=true is not supported")));
-                }
-                let roughness = if ty == "roughplastic" { Some(self.roughness(&p)?) } else { None };
-                MaterialModel::Plastic { diffuse, specular, eta, roughness }
+                let nonlinear = p.bool("nonlinear", false)?;
+                let roughness = if ty == "roughplastic" {
+                    Some(self.roughness(&p, RoughnessInput::IsotropicNumber)?)
+                } else {
+                    None
+                };
+                MaterialModel::Plastic { diffuse, specular, eta, roughness, nonlinear }
             }
             // Passes light through unchanged: the boundary of a medium (see the volpath integrator).
             "null" => MaterialModel::Null,
             "principled" => self.principled(&p)?,
             "blendbsdf" => self.blend(&p)?,
+            "pplastic" => self.pplastic(&p)?,
+            "polarizer" => self.polarizer(&p)?,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);

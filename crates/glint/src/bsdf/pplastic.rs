@@ -1,0 +1,58 @@
+//! Mitsuba's `pplastic` as its unpolarized variants (`scalar_rgb`) render it: a rough
+//! dielectric specular lobe over a diffuse base seen through two Fresnel transmissions,
+//! (1 - F(cos θo)) ρ/π (1 - F(cos θi)), with no internal-scattering series and no 1/η²
+//! (unlike `roughplastic`). The lobes are chosen with a fixed probability, the specular
+//! reflectance's share of the two albedos.
+
+use super::{fresnel_dielectric, BsdfSample, Microfacet};
+use crate::math::{Rgb, Vec3, INV_PI};
+use crate::sampling::warp;
+
+#[derive(Clone, Copy, Debug)]
+pub struct PPlasticParams {
+    pub diffuse: Rgb,
+    pub specular: Rgb,
+    /// n_inside / n_outside of the coating.
+    pub eta: f32,
+    pub dist: Microfacet,
+    /// Probability of sampling the specular lobe: mean specular over mean diffuse plus
+    /// mean specular, from the textures' means (fixed for the material, as in Mitsuba).
+    pub specular_probability: f32,
+}
+
+impl PPlasticParams {
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::BLACK;
+        }
+        let h = (wo + wi).normalize();
+        let f = fresnel_dielectric(wo.dot(h), self.eta).reflectance;
+        let specular = self.specular * (f * self.dist.d(h) * self.dist.g(wo, wi, h) / (4.0 * wo.z));
+        let (fo, fi) = (fresnel_dielectric(wo.z, self.eta).reflectance, fresnel_dielectric(wi.z, self.eta).reflectance);
+        specular + self.diffuse * ((1.0 - fo) * (1.0 - fi) * INV_PI * wi.z)
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let h = (wo + wi).normalize();
+        let ps = self.specular_probability;
+        let specular =
+            if wo.dot(h) > 0.0 && wi.dot(h) > 0.0 { self.dist.pdf_wm(wo, h) / (4.0 * wo.dot(h)) } else { 0.0 };
+        ps * specular + (1.0 - ps) * warp::cosine_hemisphere_pdf(wi.z)
+    }
+
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = if u_lobe < self.specular_probability {
+            let h = self.dist.sample_wm(wo, u);
+            h * (2.0 * wo.dot(h)) - wo
+        } else {
+            warp::cosine_hemisphere(u)
+        };
+        BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
+    }
+}
