@@ -185,8 +185,10 @@ impl Session {
         let (w, h) = (self.desc.film.width, self.desc.film.height);
         let region = opts.region.unwrap_or(Rect::full(w, h));
         let pass_spp = opts.pass_spp.unwrap_or(DEFAULT_PASS_SPP);
+        // A film the scene's own numbers cannot make (a NaN filter width, say) is the scene's
+        // error, reported at its film.
         Film::with_filter(w, h, region, pass_spp, self.desc.sampler.spp, &opts.aovs, self.desc.film.filter)
-            .map_err(Error::new)
+            .map_err(|e| Error::at(&self.desc.film.loc, e))
     }
 
     /// Renders passes into `film` until the requested passes are in, the time is up or

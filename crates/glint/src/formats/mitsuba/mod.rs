@@ -16,12 +16,10 @@ mod surface;
 pub mod xml;
 
 use super::Define;
-use crate::bsdf::MicrofacetKind;
 use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
     CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
-    MaterialRef, MediumDesc, PathSettings, Roughness, SamplerDesc, SceneDesc, ShapeDesc, ShapeMedia, TextureDesc,
-    VolpathSettings,
+    MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, ShapeDesc, ShapeMedia, TextureDesc, VolpathSettings,
 };
 use crate::error::{Error, SourceLoc};
 use crate::materials::conductor_preset;
