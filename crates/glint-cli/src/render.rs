@@ -357,14 +357,7 @@ fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
         }
         IntegratorDesc::Path(p) => {
             if let Some(depth) = a.max_depth {
-                if depth >= u32::MAX as i64 {
-                    return Err(format!(
-                        "--max-depth {depth} is out of range (-1 for unbounded, or 0 to {})",
-                        u32::MAX - 1
-                    )
-                    .into());
-                }
-                p.max_depth = if depth < 0 { None } else { Some(depth as u32) };
+                p.max_depth = unbounded_depth(depth)?;
             }
             if let Some(s) = a.strategy {
                 p.strategy = s;
@@ -372,14 +365,7 @@ fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
         }
         IntegratorDesc::Volpath(v) => {
             if let Some(depth) = a.max_depth {
-                if depth >= u32::MAX as i64 {
-                    return Err(format!(
-                        "--max-depth {depth} is out of range (-1 for unbounded, or 0 to {})",
-                        u32::MAX - 1
-                    )
-                    .into());
-                }
-                v.max_depth = if depth < 0 { None } else { Some(depth as u32) };
+                v.max_depth = unbounded_depth(depth)?;
             }
             if a.strategy.is_some() {
                 return Err("--strategy applies to the path integrator only".into());
@@ -416,4 +402,12 @@ pub fn check_output(out: &Path, desc: &SceneDesc) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// `--max-depth` for the path tracers: -1 (any negative) is unbounded.
+fn unbounded_depth(depth: i64) -> Result<Option<u32>, String> {
+    if depth >= u32::MAX as i64 {
+        return Err(format!("--max-depth {depth} is out of range (-1 for unbounded, or 0 to {})", u32::MAX - 1));
+    }
+    Ok(if depth < 0 { None } else { Some(depth as u32) })
 }
