@@ -7,6 +7,7 @@ pub mod ply;
 mod ply_attributes;
 pub mod serialized;
 mod texture_file;
+pub mod vol;
 
 pub use image_io::{read_image, write_image, Image};
 pub use texture_file::read_texture_image;
