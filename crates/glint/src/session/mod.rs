@@ -239,6 +239,19 @@ impl Session {
                 std::fs::read(&file).map_err(|e| Error::at(&SourceLoc::file(&file), format!("cannot read: {e}")))?;
             h.update(&(bytes.len() as u64).to_le_bytes());
             h.update(&bytes);
+            // An OBJ's materials come from the files its `mtllib` lines name; a missing one
+            // is hashed as absent (the reader warns and renders without it).
+            if file.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+                for mtl in crate::io::obj::mtllib_files(&bytes, &file) {
+                    match std::fs::read(&mtl) {
+                        Ok(m) => {
+                            h.update(&(m.len() as u64).to_le_bytes());
+                            h.update(&m);
+                        }
+                        Err(_) => h.update(&u64::MAX.to_le_bytes()),
+                    }
+                }
+            }
         }
         Ok(h.finish())
     }
