@@ -41,7 +41,8 @@ pub struct LightSample {
 /// A triangle-mesh emitter, with its triangles in world space and a distribution
 /// proportional to their area (the paper's choice: pick a triangle by area, then a uniform
 /// point on it). A mesh that is one rectangle is sampled by solid angle instead, from the
-/// points where that works (see `rectangle`).
+/// points where that works (see `rectangle`), and elsewhere by area through the linear map of
+/// the square onto the rectangle.
 #[derive(Clone, Debug)]
 pub struct MeshEmitter {
     pub triangles: Vec<[Vec3; 3]>,
