@@ -41,7 +41,8 @@ pub struct LightSample {
 /// A triangle-mesh emitter, with its triangles in world space and a distribution
 /// proportional to their area (the paper's choice: pick a triangle by area, then a uniform
 /// point on it). A mesh that is one rectangle is sampled by solid angle instead, from the
-/// points where that works (see `rectangle`).
+/// points where that works (see `rectangle`), and elsewhere by area through the linear map of
+/// the square onto the rectangle.
 #[derive(Clone, Debug)]
 pub struct MeshEmitter {
     pub triangles: Vec<[Vec3; 3]>,
@@ -190,6 +191,15 @@ impl Light {
                 let by_solid_angle = emitter.spherical_rectangle(p);
                 let (q, n) = match &by_solid_angle {
                     Some(sr) => (sr.sample(u), emitter.rectangle.as_ref()?.normal),
+                    // A rectangle by area: the square mapped linearly onto it, as Mitsuba's
+                    // `rectangle` does, so a stratified `u` stays stratified along both edges.
+                    // (Picking one of its two triangles with `u[0]` left each triangle, which
+                    // spans the whole length, half the strata: on thin lights 1.5-3x the error
+                    // of Mitsuba's at 16 spp.) Same density: uniform over the same area.
+                    None if emitter.rectangle.is_some() => {
+                        let r = emitter.rectangle.as_ref()?;
+                        (r.corner + r.ex * u[0] + r.ey * u[1], r.normal)
+                    }
                     None => {
                         let pick = emitter.areas.sample(u[0]);
                         let [a, b, c] = emitter.triangles[pick.index];
@@ -319,5 +329,44 @@ mod tests {
             assert!(light(true).sample_li(outside, u).is_none());
             assert!(light(true).sample_li(inside, u).is_some());
         }
+    }
+
+    /// A thin rectangle, 2 x 0.2, facing down at height 2.8, as two triangles.
+    fn thin_rectangle() -> Light {
+        let (a, b, c, d) = (vec3(-1.0, -0.1, 2.8), vec3(1.0, -0.1, 2.8), vec3(1.0, 0.1, 2.8), vec3(-1.0, 0.1, 2.8));
+        let emitter = MeshEmitter::new(vec![[a, c, b], [a, d, c]]).unwrap();
+        assert!(emitter.rectangle.is_some());
+        Light::Mesh { instance: 0, emitter: Arc::new(emitter), radiance: Rgb::WHITE, two_sided: false }
+    }
+
+    #[test]
+    fn rectangles_sampled_by_area_keep_the_strata_of_the_square() {
+        // Below the light's middle area sampling is used (the light looks nearly uniform in
+        // solid angle), by the linear map of the square onto the rectangle: a 4 x 4
+        // stratified set of u lands one point in each of the rectangle's 4 x 4 cells (cells
+        // along its edges, whichever corner the map starts from). Picking a triangle with
+        // u[0] first, as for other meshes, would not.
+        let light = thin_rectangle();
+        let p = vec3(0.0, 0.0, 0.0);
+        let Light::Mesh { emitter, .. } = &light else { unreachable!() };
+        assert!(!emitter.samples_by_solid_angle(p));
+        let mut cells = [[0u32; 4]; 4];
+        for i in 0..4 {
+            for j in 0..4 {
+                let u = [(i as f32 + 0.37) / 4.0, (j as f32 + 0.61) / 4.0];
+                let ls = light.sample_li(p, u).unwrap();
+                let q = p + ls.wi * ls.dist;
+                assert!((q.z - 2.8).abs() < 1e-4 && q.x.abs() <= 1.0 + 1e-5 && q.y.abs() <= 0.1 + 1e-6, "{q:?}");
+                let cx = (((q.x + 1.0) / 2.0 * 4.0) as usize).min(3);
+                let cy = (((q.y + 0.1) / 0.2 * 4.0) as usize).min(3);
+                cells[cx][cy] += 1;
+                // The density is area sampling's, and what pdf_li says for the same point.
+                let n = vec3(0.0, 0.0, -1.0);
+                let expected = ls.dist * ls.dist / (-n.dot(ls.wi) * 0.4);
+                assert!((ls.pdf / expected - 1.0).abs() < 1e-4, "{} vs {expected}", ls.pdf);
+                assert!((light.pdf_li(p, ls.wi, q, n) / ls.pdf - 1.0).abs() < 1e-4);
+            }
+        }
+        assert_eq!(cells, [[1; 4]; 4]);
     }
 }
