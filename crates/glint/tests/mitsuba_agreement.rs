@@ -216,6 +216,13 @@ fn cylinder_shape() {
     check("cylinder");
 }
 
+/// sdfgrid: a torus grid placed directly with smooth normals and through a rotating
+/// shapegroup/instance with analytic normals.
+#[test]
+fn sdfgrid_shape() {
+    check("sdfgrid");
+}
+
 /// shapegroup and instance: a group of a serialized mesh, a sphere and a cube drawn three
 /// times through the instances' transforms.
 #[test]

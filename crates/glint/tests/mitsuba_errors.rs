@@ -134,3 +134,61 @@ fn direct_integrator_sample_counts() {
         assert!(e.contains("direct.xml:4:") && e.contains(needle), "{params}: {e}");
     }
 }
+
+/// A one-channel `.vol` file of `res` samples per axis (values x fastest).
+fn vol_bytes(res: [i32; 3], channels: i32, values: &[f32]) -> Vec<u8> {
+    let mut b = b"VOL\x03".to_vec();
+    for v in [1, res[0], res[1], res[2], channels] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0].iter().chain(values) {
+        b.extend(v.to_le_bytes());
+    }
+    b
+}
+
+fn sdf_scene(shape_body: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"sdfgrid\">\n{shape_body}\n</shape>\n</scene>\n")
+}
+
+#[test]
+fn sdfgrid_bad_files_and_parameters() {
+    let dir = write("sdf-dummy.txt", "").parent().unwrap().to_path_buf();
+    // Missing file, a file that is not a grid, a truncated one, three channels, no surface.
+    let e = error_of("sdf-missing.xml", &sdf_scene(" <string name=\"filename\" value=\"nowhere.vol\"/>"));
+    assert!(e.contains("sdf-missing.xml:4:") && e.contains("nowhere.vol"), "{e}");
+    std::fs::write(dir.join("sdf-text.vol"), "not a grid").unwrap();
+    let e = error_of("sdf-corrupt.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-text.vol\"/>"));
+    assert!(e.contains("sdf-corrupt.xml:4:") && e.contains("VOL"), "{e}");
+    let mut short = vol_bytes([2, 2, 2], 1, &[1.0; 8]);
+    short.truncate(short.len() - 4);
+    std::fs::write(dir.join("sdf-short.vol"), short).unwrap();
+    let e = error_of("sdf-short.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-short.vol\"/>"));
+    assert!(e.contains("sdf-short.xml:4:") && e.contains("sdf-short.vol"), "{e}");
+    std::fs::write(dir.join("sdf-rgb.vol"), vol_bytes([2, 2, 2], 3, &[1.0; 24])).unwrap();
+    let e = error_of("sdf-rgb.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-rgb.vol\"/>"));
+    assert!(e.contains("sdf-rgb.xml:4:") && e.contains("1 channel, this one has 3"), "{e}");
+    std::fs::write(dir.join("sdf-empty.vol"), vol_bytes([2, 2, 2], 1, &[1.0; 8])).unwrap();
+    let e = error_of("sdf-empty.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-empty.vol\"/>"));
+    assert!(e.contains("sdf-empty.xml:4:") && e.contains("no surface"), "{e}");
+    std::fs::write(dir.join("sdf-flat.vol"), vol_bytes([1, 2, 2], 1, &[1.0; 4])).unwrap();
+    let e = error_of("sdf-flat.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-flat.vol\"/>"));
+    assert!(e.contains("sdf-flat.xml:4:") && e.contains("at least 2 samples"), "{e}");
+
+    // Unsupported parameters and uses.
+    let good = vol_bytes([2, 2, 2], 1, &[-1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0]);
+    std::fs::write(dir.join("sdf-good.vol"), good).unwrap();
+    let file = " <string name=\"filename\" value=\"sdf-good.vol\"/>";
+    let e = error_of("sdf-normals.xml", &sdf_scene(&format!("{file}\n <string name=\"normals\" value=\"flat\"/>")));
+    assert!(e.contains("sdf-normals.xml:6:") && e.contains("'flat'"), "{e}");
+    let e = error_of("sdf-noname.xml", &sdf_scene(" <string name=\"normals\" value=\"smooth\"/>"));
+    assert!(e.contains("sdf-noname.xml:4:") && e.contains("needs 'filename'"), "{e}");
+    let emitter = "<emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter>";
+    let e = error_of("sdf-emit.xml", &sdf_scene(&format!("{file}\n {emitter}")));
+    assert!(e.contains("sdf-emit.xml:4:") && e.contains("cannot emit"), "{e}");
+    let e = error_of("sdf-flip.xml", &sdf_scene(&format!("{file}\n <boolean name=\"flip_normals\" value=\"true\"/>")));
+    assert!(e.contains("sdf-flip.xml:4:") && e.contains("flip_normals"), "{e}");
+    // The good grid loads, by itself and through an instance.
+    let p = write("sdf-ok.xml", &sdf_scene(file));
+    assert!(load(&p, &[], None).is_ok());
+}

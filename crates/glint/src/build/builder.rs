@@ -5,7 +5,7 @@
 use crate::accel::BvhSplit;
 use crate::camera::Camera;
 use crate::describe::Emission;
-use crate::geometry::{Cylinder, Sphere, TriangleMesh};
+use crate::geometry::{Cylinder, SdfGrid, SdfGridData, SdfNormals, Sphere, TriangleMesh};
 use crate::io::{obj, ply, serialized};
 use crate::lights::LightSelection;
 use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
@@ -116,6 +116,9 @@ pub struct WorldBuilder {
     meshes: Vec<Arc<TriangleMesh>>,
     spheres: Vec<Sphere>,
     cylinders: Vec<Cylinder>,
+    sdf_grids: Vec<SdfGrid>,
+    /// SDF grids by file, loaded once however often they are placed.
+    sdf_data: HashMap<std::path::PathBuf, Arc<SdfGridData>>,
     instances: Vec<Instance>,
     materials: Vec<Material>,
     material_names: HashMap<String, u32>,
@@ -133,6 +136,8 @@ impl WorldBuilder {
             meshes: Vec::new(),
             spheres: Vec::new(),
             cylinders: Vec::new(),
+            sdf_grids: Vec::new(),
+            sdf_data: HashMap::new(),
             instances: Vec::new(),
             materials: Vec::new(),
             material_names: HashMap::new(),
@@ -339,6 +344,56 @@ impl WorldBuilder {
         Ok(())
     }
 
+    /// Places the signed distance grid of a Mitsuba `.vol` file (one channel) over the unit
+    /// cube mapped by `to_world`; the file's bounding box is ignored, as in Mitsuba.
+    pub fn add_sdf_grid(
+        &mut self,
+        file: &std::path::Path,
+        normals: SdfNormals,
+        to_world: &Transform,
+        material: u32,
+        emission: Option<Emission>,
+    ) -> Result<(), String> {
+        if emission.is_some() {
+            return Err("an emitting sdfgrid is not supported (Mitsuba's cannot emit either)".into());
+        }
+        let data = match self.sdf_data.get(file) {
+            Some(d) => d.clone(),
+            None => {
+                let start = Instant::now();
+                let grid = crate::io::vol::read_vol(file)?;
+                if grid.channels != 1 {
+                    return Err(format!(
+                        "{}: an SDF grid has 1 channel, this one has {}",
+                        file.display(),
+                        grid.channels
+                    ));
+                }
+                let data = Arc::new(
+                    SdfGridData::new(grid.resolution, grid.data, self.split)
+                        .map_err(|e| format!("{}: {e}", file.display()))?,
+                );
+                self.build_seconds += start.elapsed().as_secs_f64();
+                self.sdf_data.insert(file.to_path_buf(), data.clone());
+                data
+            }
+        };
+        let grid = SdfGrid::new(data, to_world, normals).ok_or("an sdfgrid needs an invertible, finite transform")?;
+        let id = self.sdf_grids.len() as u32;
+        let bounds = grid.bounds();
+        self.sdf_grids.push(grid);
+        self.instances.push(Instance {
+            shape: ShapeRef::SdfGrid(id),
+            to_world: None,
+            material,
+            light: None,
+            flip_normals: false,
+            bounds,
+            media: MediumBoundary::default(),
+        });
+        Ok(())
+    }
+
     pub fn add_light(&mut self, light: Light) {
         self.lights.push(PendingLight::Ready(light));
     }
@@ -392,6 +447,7 @@ impl WorldBuilder {
             meshes: self.meshes,
             spheres: self.spheres,
             cylinders: self.cylinders,
+            sdf_grids: self.sdf_grids,
             instances: self.instances,
             top: Default::default(),
             materials: self.materials,

@@ -10,9 +10,9 @@ use super::builder::{bake, environment_lights, read_mesh_file};
 use super::{add_light, camera, material_id, material_kind, mesh_loc, transform_of, validate, TextureCache};
 use super::{BuildOptions, LoadedGroup, WorldBuilder};
 use crate::accel::BvhSplit;
-use crate::describe::{Geometry, MaterialRef, Matrix4, SceneDesc, ShapeDesc};
+use crate::describe::{Geometry, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc, ShapeDesc};
 use crate::error::{Error, SourceLoc};
-use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, TriangleMesh};
+use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, SdfNormals, TriangleMesh};
 use crate::lights::Light;
 use crate::materials::Material;
 use crate::math::Transform;
@@ -214,6 +214,21 @@ fn add_shape(
         }
         Geometry::Cylinder { p0, p1, radius } => {
             return Ok(b.add_cylinder(*p0, *p1, *radius, &to_world, material, s.emission, s.flip_normals)?);
+        }
+        Geometry::SdfGrid { file, normals } => {
+            check_attributes(desc, s, None)?;
+            return b
+                .add_sdf_grid(
+                    file,
+                    match normals {
+                        SdfNormalsDesc::Analytic => SdfNormals::Analytic,
+                        SdfNormalsDesc::Smooth => SdfNormals::Smooth,
+                    },
+                    &to_world,
+                    material,
+                    s.emission,
+                )
+                .map_err(|e| Error::at(&s.loc, e));
         }
         g => (Source::Shape { index: place.index, geometry: geometry_hash(g) }, false),
     };

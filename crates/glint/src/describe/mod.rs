@@ -366,6 +366,23 @@ pub enum Geometry {
         p1: Vec3,
         radius: f32,
     },
+    /// A signed distance grid (Mitsuba's `sdfgrid`): a one-channel `.vol` file sampled at the
+    /// vertices of a regular grid over the unit cube; the surface is the zero level set of
+    /// its trilinear interpolant. The file's bounding box is ignored (as in Mitsuba).
+    SdfGrid {
+        file: PathBuf,
+        normals: SdfNormalsDesc,
+    },
+}
+
+/// How an SDF grid's shading normals are computed (Mitsuba's `normals`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SdfNormalsDesc {
+    /// The gradient of the hit voxel's trilinear interpolant.
+    Analytic,
+    /// Blended gradients of the neighbouring voxels (Mitsuba's default).
+    Smooth,
 }
 
 fn is_zero(v: &u32) -> bool {
@@ -489,7 +506,7 @@ impl SceneDesc {
             add(&m.file);
         }
         for s in &self.shapes {
-            if let Geometry::MeshFile { file, .. } = &s.geometry {
+            if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } = &s.geometry {
                 add(file);
             }
         }
@@ -522,7 +539,7 @@ impl SceneDesc {
             map(&mut m.file)?;
         }
         for s in &mut self.shapes {
-            if let Geometry::MeshFile { file, .. } = &mut s.geometry {
+            if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } = &mut s.geometry {
                 map(file)?;
             }
         }

@@ -1,8 +1,10 @@
-//! Shapes: triangle meshes (with their own BVH), analytic spheres and cylinders.
+//! Shapes: triangle meshes (with their own BVH), analytic spheres and cylinders, signed
+//! distance grids.
 
 mod attributes;
 mod cylinder;
 mod mesh;
+mod sdfgrid;
 mod sphere;
 
 pub use attributes::{AttributeScope, MeshAttribute};
@@ -10,4 +12,5 @@ pub use cylinder::{Cylinder, CylinderPoint};
 pub use mesh::{
     cube_mesh, disk_mesh, quad_mesh, rectangle_mesh, AccelStats, MeshAccel, TriangleMesh, WideTris, DISK_SEGMENTS,
 };
+pub use sdfgrid::{solve_first_root, SdfGrid, SdfGridData, SdfNormals, SdfPoint};
 pub use sphere::Sphere;

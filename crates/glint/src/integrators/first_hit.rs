@@ -90,6 +90,13 @@ pub fn closest_hit_cost(scene: &World, ray: &Ray) -> u64 {
                     }
                     None => false,
                 },
+                ShapeRef::SdfGrid(g) => match scene.sdf_grids[g as usize].intersect(r) {
+                    Some((t, _)) => {
+                        r.t_max = t;
+                        true
+                    }
+                    None => false,
+                },
             }
         });
     }

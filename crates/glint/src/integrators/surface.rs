@@ -15,7 +15,7 @@ pub(crate) const MAX_MASK_PASSES: u32 = 256;
 pub(crate) fn texture_point<'a>(scene: &'a World, si: &SurfaceInteraction) -> TexturePoint<'a> {
     let mesh = scene.instances.get(si.instance as usize).and_then(|inst| match inst.shape {
         ShapeRef::Mesh(m) => scene.meshes.get(m as usize).map(|m| &**m),
-        ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) => None,
+        ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) => None,
     });
     TexturePoint { uv: si.uv, prim: si.prim, bary: si.bary, mesh }
 }

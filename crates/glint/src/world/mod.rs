@@ -9,7 +9,7 @@
 
 use crate::accel::{BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
-use crate::geometry::{Cylinder, Sphere, TriangleMesh};
+use crate::geometry::{Cylinder, SdfGrid, Sphere, TriangleMesh};
 use crate::lights::{Light, LightSelection};
 use crate::materials::Material;
 use crate::math::{Aabb, Frame, Ray, Transform, Vec3};
@@ -22,6 +22,7 @@ pub enum ShapeRef {
     Mesh(u32),
     Sphere(u32),
     Cylinder(u32),
+    SdfGrid(u32),
 }
 
 #[derive(Clone, Debug)]
@@ -77,6 +78,7 @@ pub struct World {
     pub(crate) meshes: Vec<Arc<TriangleMesh>>,
     pub(crate) spheres: Vec<Sphere>,
     pub(crate) cylinders: Vec<Cylinder>,
+    pub(crate) sdf_grids: Vec<SdfGrid>,
     pub(crate) instances: Vec<Instance>,
     /// Over instances: the binary reference and the 8-wide tree that traversal uses.
     pub(crate) top: TopLevelBvh,
@@ -193,6 +195,9 @@ impl World {
             ShapeRef::Cylinder(c) => {
                 self.cylinders[c as usize].intersect(r).map(|t| Hit { t, instance: 0, prim: 0, b1: 0.0, b2: 0.0 })
             }
+            ShapeRef::SdfGrid(g) => {
+                self.sdf_grids[g as usize].intersect(r).map(|(t, prim)| Hit { t, instance: 0, prim, b1: 0.0, b2: 0.0 })
+            }
         }
     }
 
@@ -216,6 +221,7 @@ impl World {
                 }
                 ShapeRef::Sphere(s) => self.spheres[s as usize].intersect(r).is_some(),
                 ShapeRef::Cylinder(c) => self.cylinders[c as usize].intersect(r).is_some(),
+                ShapeRef::SdfGrid(g) => self.sdf_grids[g as usize].occluded(r),
             }
         })
     }
@@ -250,6 +256,13 @@ impl World {
                     t,
                     instance: i as u32,
                     prim: 0,
+                    b1: 0.0,
+                    b2: 0.0,
+                }),
+                ShapeRef::SdfGrid(g) => self.sdf_grids[g as usize].intersect(&r).map(|(t, prim)| Hit {
+                    t,
+                    instance: i as u32,
+                    prim,
                     b1: 0.0,
                     b2: 0.0,
                 }),
@@ -321,6 +334,11 @@ impl World {
                 let q = self.cylinders[c as usize].point(ray, hit.t);
                 (q.p, q.n, None, q.uv, q.dpdu, q.dpdv)
             }
+            ShapeRef::SdfGrid(g) => {
+                // No uv parameterisation (as in Mitsuba): uv and its derivatives are zero.
+                let q = self.sdf_grids[g as usize].point(ray, hit.t, hit.prim);
+                (q.p, q.n, Some(q.shading_n), [0.0, 0.0], Vec3::ZERO, Vec3::ZERO)
+            }
         };
         ng = ng.normalize();
         if inst.flip_normals {
@@ -368,6 +386,9 @@ impl World {
     pub fn cylinders(&self) -> &[Cylinder] {
         &self.cylinders
     }
+    pub fn sdf_grids(&self) -> &[SdfGrid] {
+        &self.sdf_grids
+    }
     pub fn instances(&self) -> &[Instance] {
         &self.instances
     }
@@ -405,7 +426,7 @@ impl World {
             .iter()
             .map(|i| match i.shape {
                 ShapeRef::Mesh(m) => self.meshes[m as usize].indices.len(),
-                ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) => 0,
+                ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) => 0,
             })
             .sum()
     }

@@ -19,7 +19,8 @@ use super::Define;
 use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
     CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
-    MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, ShapeDesc, ShapeMedia, TextureDesc, VolpathSettings,
+    MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
+    VolpathSettings,
 };
 use crate::error::{Error, SourceLoc};
 use crate::materials::conductor_preset;
@@ -499,6 +500,17 @@ impl<'a> Reader<'a> {
                 Err(el.err("an emitting cylinder is not supported (give the emitter to a mesh or sphere)")),
             );
         }
+        if ty == "sdfgrid" {
+            if emission.is_some() {
+                self.note::<()>(Err(el.err("an sdfgrid cannot emit light (as in Mitsuba)")));
+            }
+            if media != ShapeMedia::default() {
+                self.note::<()>(Err(el.err("sdfgrid: interior/exterior media are not supported")));
+            }
+            if flip_normals {
+                self.note::<()>(Err(el.err("sdfgrid: flip_normals is not supported (Mitsuba ignores it)")));
+            }
+        }
         // Mitsuba gives a shape without a BSDF a diffuse 0.5 one, and an emitting shape a
         // black one (its light does not reflect light).
         let material = match (material, &emission) {
@@ -541,6 +553,19 @@ impl<'a> Reader<'a> {
             "rectangle" => Geometry::Rectangle,
             "cube" => Geometry::Cube,
             "disk" => Geometry::Disk,
+            "sdfgrid" => {
+                // Mitsuba's `grid` (a tensor) can only be given from Python or C++.
+                let file = p.string("filename").ok_or_else(|| el.err("shape 'sdfgrid' needs 'filename'"))?;
+                let normals = match p.string("normals").unwrap_or("smooth") {
+                    "smooth" => SdfNormalsDesc::Smooth,
+                    "analytic" => SdfNormalsDesc::Analytic,
+                    other => {
+                        let at = p.find("normals").unwrap_or(el);
+                        return Err(at.err(format!("sdfgrid: normals '{other}' must be 'analytic' or 'smooth'")));
+                    }
+                };
+                Geometry::SdfGrid { file: self.resolve_file(el, file), normals }
+            }
             other => return Err(el.err(format!("shape plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
