@@ -191,3 +191,63 @@ fn the_json_format_describes_the_same_features() {
     let r = world.camera().generate_ray(0.0, 2.0, [0.5; 2]);
     assert!((r.origin.x.abs() - 1.5).abs() < 1e-4, "{:?}", r.origin);
 }
+
+/// A sphere's signed distance (radius 0.3 around the cube's centre) on 9^3 vertices, as a
+/// Mitsuba `.vol` file whose bounding box (which Mitsuba ignores) is not the unit cube.
+fn sphere_vol(path: &Path) {
+    let n = 9;
+    let mut b = b"VOL\x03".to_vec();
+    for v in [1i32, n, n, n, 1] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [-5.0f32, -5.0, -5.0, 7.0, 7.0, 7.0] {
+        b.extend(v.to_le_bytes());
+    }
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let p = vec3(x as f32, y as f32, z as f32) / (n - 1) as f32 - Vec3::splat(0.5);
+                b.extend((p.length() - 0.3).to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+#[test]
+fn sdfgrid_is_placed_on_the_unit_cube_directly_and_through_instances() {
+    let dir = scratch("sdfgrid");
+    sphere_vol(&dir.join("ball.vol"));
+    let desc = read(
+        &dir,
+        r#"<shape type="sdfgrid"><string name="filename" value="ball.vol"/>
+             <transform name="to_world"><scale value="2"/><translate x="-1" y="-1" z="-1"/></transform></shape>
+           <shape type="shapegroup" id="g">
+             <shape type="sdfgrid"><string name="filename" value="ball.vol"/>
+               <string name="normals" value="analytic"/></shape>
+           </shape>
+           <shape type="instance"><ref id="g"/>
+             <transform name="to_world"><translate x="-0.5" y="-0.5" z="-0.5"/><translate x="5"/></transform></shape>"#,
+    )
+    .unwrap();
+    use glint::describe::SdfNormalsDesc;
+    assert!(matches!(desc.shapes[0].geometry, Geometry::SdfGrid { normals: SdfNormalsDesc::Smooth, .. }));
+    assert!(matches!(desc.shapes[1].geometry, Geometry::SdfGrid { normals: SdfNormalsDesc::Analytic, .. }));
+    let world = build(&desc, &BuildOptions::default()).unwrap();
+    assert_eq!(world.sdf_grids().len(), 2);
+    // The first: a ball of radius 0.6 at the origin (the file's box is ignored). The ray
+    // keeps off the grid lines, where the analytic normal jumps between voxels; between
+    // them the coarse grid interpolates the distance within an eighth of a cell (0.25).
+    let ray = Ray::new(vec3(-5.0, 0.07, 0.03), Vec3::X);
+    let hit = world.intersect(&ray).unwrap();
+    assert!((hit.t - 4.405).abs() < 0.03, "{}", hit.t);
+    let si = world.interaction(&ray, &hit);
+    let n = (ray.at(hit.t)).normalize();
+    assert!(si.ng.dot(n) > 0.98 && si.frame.n.dot(n) > 0.98, "{:?} {:?} vs {n:?}", si.ng, si.frame.n);
+    assert_eq!(si.uv, [0.0, 0.0]);
+    // The instance: radius 0.3 at (5, 0, 0), seen from above.
+    let ray = Ray::new(vec3(5.0, 0.0, 5.0), -Vec3::Z);
+    let hit = world.intersect(&ray).unwrap();
+    assert!((hit.t - 4.7).abs() < 0.03, "{}", hit.t);
+    assert!(world.occluded(&ray) && world.intersect_brute_force(&ray).unwrap().t == hit.t);
+}

@@ -139,7 +139,7 @@ impl SdfGridData {
     /// and the voxel (primitive) index.
     pub fn intersect(&self, o: [f64; 3], d: [f64; 3], t_min: f32, t_max: f32) -> Option<(f32, u32)> {
         let (of, df) = (vec3(o[0] as f32, o[1] as f32, o[2] as f32), vec3(d[0] as f32, d[1] as f32, d[2] as f32));
-        if !(of.is_finite() && df.is_finite()) || !(t_min <= t_max) {
+        if !(of.is_finite() && df.is_finite() && t_min <= t_max) {
             return None;
         }
         let mut ray = Ray { origin: of, dir: df, t_min, t_max };
@@ -158,7 +158,7 @@ impl SdfGridData {
     /// True when the index-space ray meets the surface within `(t_min, t_max)`.
     pub fn occluded(&self, o: [f64; 3], d: [f64; 3], t_min: f32, t_max: f32) -> bool {
         let (of, df) = (vec3(o[0] as f32, o[1] as f32, o[2] as f32), vec3(d[0] as f32, d[1] as f32, d[2] as f32));
-        if !(of.is_finite() && df.is_finite()) || !(t_min <= t_max) {
+        if !(of.is_finite() && df.is_finite() && t_min <= t_max) {
             return false;
         }
         let ray = Ray { origin: of, dir: df, t_min, t_max };
@@ -173,18 +173,20 @@ impl SdfGridData {
         let lo: [f64; 3] = std::array::from_fn(|a| o[a] - v[a] as f64);
         let (mut t0, mut t1) = (t_min as f64, t_max as f64);
         for a in 0..3 {
-            let inv = 1.0 / d[a];
-            let (mut ta, mut tb) = (-lo[a] * inv, (1.0 - lo[a]) * inv);
+            if d[a] == 0.0 {
+                // Parallel to the slab (either sign of zero): inside it, the closed interval
+                // included, or no hit.
+                if !(0.0..=1.0).contains(&lo[a]) {
+                    return None;
+                }
+                continue;
+            }
+            let (mut ta, mut tb) = (-lo[a] / d[a], (1.0 - lo[a]) / d[a]);
             if ta > tb {
                 std::mem::swap(&mut ta, &mut tb);
             }
-            // NaN (a ray in the plane of a face): the axis does not constrain the interval.
-            if !ta.is_nan() {
-                t0 = t0.max(ta);
-            }
-            if !tb.is_nan() {
-                t1 = t1.min(tb);
-            }
+            t0 = t0.max(ta);
+            t1 = t1.min(tb);
         }
         if !(t0 <= t1) || !t0.is_finite() || !t1.is_finite() {
             return None;
@@ -569,9 +571,13 @@ mod tests {
         let mut r = Ray::new(vec3(-3.0, -1.5, 1.0), Vec3::X);
         r.t_max = f32::NAN;
         assert!(g.intersect(&r).is_none());
-        // Along a grid plane exactly (a zero direction component, the origin on a face).
-        let r = Ray::new(g.to_world.point(vec3(-3.0, 16.0, 16.0)), g.to_world.vector(Vec3::X));
-        assert!(g.intersect(&r).is_some());
+        // Along grid planes exactly (zero direction components of either sign, the origin
+        // on voxel faces).
+        for d in [vec3(1.0, 0.0, 0.0), vec3(1.0, -0.0, -0.0), vec3(-1.0, -0.0, 0.0)] {
+            let start = if d.x > 0.0 { -3.0 } else { 35.0 };
+            let r = Ray::new(g.to_world.point(vec3(start, 16.0, 16.0)), d);
+            assert!(g.intersect(&r).is_some(), "{d:?}");
+        }
     }
 
     #[test]
