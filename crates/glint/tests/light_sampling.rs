@@ -16,6 +16,7 @@ use common::bsdf_check::chi2_test;
 use common::stats::{sidak, FALSE_ALARM};
 use glint::geometry::Sphere;
 use glint::lights::{Light, MeshEmitter};
+use glint::materials::Texture;
 use glint::math::{vec3, Frame, Ray, Rgb, Vec3};
 use glint::sampling::Rng;
 use std::sync::Arc;
@@ -51,7 +52,7 @@ fn sphere_case(label: &'static str, center: Vec3, radius: f32, p: Vec3) -> Case 
     });
     Case {
         label,
-        light: Light::Sphere { instance: 0, sphere: s, radiance: Rgb::WHITE, inward: false },
+        light: Light::Sphere { instance: 0, sphere: s, radiance: Texture::Constant(Rgb::WHITE), inward: false },
         p,
         axis: (center - p).normalize(),
         extent: 1.02 * radius / (d * d - radius * radius).sqrt(),
@@ -94,7 +95,12 @@ fn rectangle_case(label: &'static str, corner: Vec3, ex: Vec3, ey: Vec3, p: Vec3
     });
     Case {
         label,
-        light: Light::Mesh { instance: 0, emitter: Arc::new(emitter), radiance: Rgb::WHITE, two_sided: false },
+        light: Light::Mesh {
+            instance: 0,
+            emitter: Arc::new(emitter),
+            radiance: Texture::Constant(Rgb::WHITE),
+            two_sided: false,
+        },
         p,
         axis,
         extent,

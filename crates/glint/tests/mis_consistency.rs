@@ -10,9 +10,8 @@ use common::stats::{block_estimates, image_estimate, z_critical, Estimate, FALSE
 use glint::accel::BvhSplit;
 use glint::bsdf::{Microfacet, MicrofacetKind};
 use glint::build::WorldBuilder;
-use glint::describe::Emission;
 use glint::integrators::{Integrator, PathSettings, Strategy};
-use glint::lights::LightSelection;
+use glint::lights::{AreaEmission, LightSelection};
 use glint::materials::{Material, MaterialKind};
 use glint::math::{rgb, vec3, Rgb, Transform, Vec3};
 use glint::world::World;
@@ -120,7 +119,7 @@ fn strategies_agree_on_emitters_seen_from_behind() {
     add_square(&mut b, vec3(-0.8, 1.0, 0.0), 1, 1.0, 0.4, lamp, emission(10.0));
     b.add_sphere(vec3(0.8, 0.8, -0.3), 0.4, &Transform::IDENTITY, lamp, emission(10.0), true).unwrap();
     let facing_camera = [vec3(-0.3, 0.2, 1.0), vec3(0.3, 0.2, 1.0), vec3(0.3, 0.6, 1.0), vec3(-0.3, 0.6, 1.0)];
-    add_quad(&mut b, facing_camera, lamp, Some(Emission { radiance: Rgb::splat(3.0), two_sided: false }));
+    add_quad(&mut b, facing_camera, lamp, Some(AreaEmission::constant(Rgb::splat(3.0))));
     let cam = camera(vec3(0.0, 2.0, 4.0), vec3(0.0, 0.3, 0.0), Vec3::Y, 50.0, SIZE, SIZE);
     let scene = b.finish(cam, LightSelection::Power).unwrap();
     assert_strategies_agree(&scene, PathSettings::default(), SPP);

@@ -271,3 +271,10 @@ fn anisotropic_and_textured_roughness() {
 fn nonlinear_plastics_pplastic_and_polarizer() {
     check("plastics");
 }
+
+/// Area emitters whose radiance is a texture (a bitmap on a rectangle and on a cylinder, a
+/// checkerboard on a sphere), read at the surface's uv, and an emitting cylinder.
+#[test]
+fn textured_area_emitters_and_an_emitting_cylinder() {
+    check("area-textured");
+}

@@ -3,9 +3,10 @@
 
 use glint::build::{build, BuildOptions};
 use glint::camera::{CropWindow, Projection};
-use glint::describe::{Geometry, LightKind, SceneDesc};
+use glint::describe::{Geometry, LightKind, SceneDesc, TextureDesc};
 use glint::formats::mitsuba::read_str;
-use glint::math::{vec3, Ray, Vec3};
+use glint::lights::Light;
+use glint::math::{rgb, vec3, Ray, Rgb, Vec3};
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
@@ -112,13 +113,83 @@ fn cylinder_is_read_with_mitsubas_defaults_and_hit_in_the_world() {
     assert!(world.occluded(&Ray::segment(vec3(3.0, 0.0, 1.5), vec3(-1.0, 0.0, 0.0), 10.0)));
     // Above the open tube: nothing.
     assert!(world.intersect(&Ray::new(vec3(3.0, 0.0, 2.5), vec3(-1.0, 0.0, 0.0))).is_none());
-    // A zero radius and an emitting cylinder are one-line errors.
+    // A zero radius is a one-line error.
     let err = read(&dir, r#"<shape type="cylinder"><float name="radius" value="0"/></shape>"#)
         .and_then(|d| build(&d, &BuildOptions::default()).map(|_| ()).map_err(|e| e.to_string()))
         .unwrap_err();
-    assert!(err.contains("radius") && err.contains("scene.xml:"), "{err}");
-    let err = read(&dir, r#"<shape type="cylinder"><emitter type="area"/></shape>"#).unwrap_err();
-    assert!(err.contains("emitting cylinder"), "{err}");
+    assert!(err.contains("radius") && err.contains("scene.xml:") && !err.contains('\n'), "{err}");
+}
+
+#[test]
+fn an_emitting_cylinder_is_an_area_light_of_its_area() {
+    let dir = scratch("cylinder-light");
+    let desc = read(
+        &dir,
+        r#"<shape type="cylinder"><float name="radius" value="0.5"/><point name="p1" x="0" y="0" z="2"/>
+             <emitter type="area"><rgb name="radiance" value="2, 3, 4"/></emitter></shape>"#,
+    )
+    .unwrap();
+    let world = build(&desc, &BuildOptions::default()).unwrap();
+    assert_eq!(world.lights().len(), 1);
+    assert!(matches!(world.lights()[0], Light::Cylinder { inward: false, .. }));
+    let area = 2.0 * std::f32::consts::PI * 0.5 * 2.0;
+    assert!((world.lights()[0].area() - area).abs() < 1e-4 * area, "{}", world.lights()[0].area());
+    // Seen from outside, light samples come from the side facing the point (outward normals).
+    let p = vec3(3.0, 0.0, 1.0);
+    for u in [[0.1, 0.3], [0.4, 0.6], [0.8, 0.9]] {
+        if let Some(ls) = world.lights()[0].sample_li(p, u) {
+            assert!(ls.pdf > 0.0 && ls.wi.x < 0.0 && ls.radiance == rgb(2.0, 3.0, 4.0), "{ls:?}");
+        }
+    }
+}
+
+#[test]
+fn textured_area_emitters_are_read() {
+    let dir = scratch("textured-emitters");
+    let desc = read(
+        &dir,
+        r#"<texture type="checkerboard" id="tiles"><rgb name="color0" value="0.9"/><rgb name="color1" value="0.1"/></texture>
+           <shape type="rectangle"><emitter type="area">
+             <texture type="bitmap" name="radiance"><string name="filename" value="glow.png"/></texture></emitter></shape>
+           <shape type="sphere"><emitter type="area"><ref name="radiance" id="tiles"/></emitter></shape>
+           <shape type="cylinder"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>"#,
+    )
+    .unwrap();
+    let radiance = |i: usize| desc.shapes[i].emission.as_ref().unwrap().radiance.clone();
+    assert!(matches!(radiance(0), TextureDesc::Bitmap { ref file, .. } if file.ends_with("glow.png")));
+    assert!(matches!(radiance(1), TextureDesc::Checkerboard { color0, .. } if color0 == Rgb::splat(0.9)));
+    assert!(matches!(radiance(2), TextureDesc::Checkerboard { .. }));
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+
+    // What glint does not read is one line naming the file and line.
+    let one_line = |body: &str, wanted: &str| {
+        let err = read(&dir, body)
+            .and_then(|d| build(&d, &BuildOptions::default()).map(|_| ()).map_err(|e| e.to_string()))
+            .unwrap_err();
+        assert!(err.contains(wanted) && err.contains("scene.xml:") && !err.contains('\n'), "{err}");
+    };
+    one_line(
+        r#"<shape type="rectangle"><emitter type="area">
+             <texture type="noise" name="radiance"/></emitter></shape>"#,
+        "texture plugin 'noise'",
+    );
+    one_line(
+        r#"<shape type="rectangle"><emitter type="area">
+             <texture type="bitmap" name="radiance"/></emitter></shape>"#,
+        "filename",
+    );
+    one_line(
+        r#"<shape type="rectangle"><emitter type="area">
+             <texture type="bitmap" name="radiance"><string name="filename" value="missing.png"/></texture></emitter></shape>"#,
+        "missing.png",
+    );
+    // A mesh attribute the shape does not have (a sphere has none).
+    one_line(
+        r#"<shape type="sphere"><emitter type="area">
+             <texture type="mesh_attribute" name="radiance"><string name="name" value="vertex_color"/></texture>
+           </emitter></shape>"#,
+        "vertex_color",
+    );
 }
 
 #[test]

@@ -4,11 +4,10 @@
 
 use crate::accel::BvhSplit;
 use crate::camera::Camera;
-use crate::describe::Emission;
 use crate::geometry::{Cylinder, SdfGrid, SdfGridData, SdfNormals, Sphere, TriangleMesh};
 use crate::io::{obj, ply, serialized};
 use crate::lights::LightSelection;
-use crate::lights::{scene_radius, EnvMap, Light, MeshEmitter};
+use crate::lights::{scene_radius, AreaEmission, EnvMap, Light, MeshEmitter};
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
 use crate::math::{Aabb, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
@@ -210,7 +209,7 @@ impl WorldBuilder {
         to_world: &Transform,
         instanced: bool,
         material: u32,
-        emission: Option<Emission>,
+        emission: Option<AreaEmission>,
         flip_normals: bool,
     ) -> Result<(), String> {
         let (mesh, xf) = if instanced || to_world.is_identity() {
@@ -242,7 +241,7 @@ impl WorldBuilder {
         });
         let light = match light {
             Some((triangles, e)) => {
-                let Some(emitter) = MeshEmitter::new(triangles) else {
+                let Some(emitter) = MeshEmitter::of_mesh(triangles, mesh.clone(), flip_normals) else {
                     return Err("an emitting mesh has zero area".into());
                 };
                 self.lights.push(PendingLight::Ready(Light::Mesh {
@@ -274,7 +273,7 @@ impl WorldBuilder {
         radius: f32,
         to_world: &Transform,
         material: u32,
-        emission: Option<Emission>,
+        emission: Option<AreaEmission>,
         flip_normals: bool,
     ) -> Result<(), String> {
         let c = to_world.point(center);
@@ -293,6 +292,7 @@ impl WorldBuilder {
         self.spheres.push(sphere);
         let instance = self.instances.len() as u32;
         let light = emission.map(|e| {
+            // A sphere emits on the side its normal faces (Mitsuba has no two-sided area light).
             self.lights.push(PendingLight::Ready(Light::Sphere {
                 instance,
                 sphere,
@@ -322,21 +322,32 @@ impl WorldBuilder {
         radius: f32,
         to_world: &Transform,
         material: u32,
-        emission: Option<Emission>,
+        emission: Option<AreaEmission>,
         flip_normals: bool,
     ) -> Result<(), String> {
-        if emission.is_some() {
-            return Err("an emitting cylinder is not supported (give the emitter to a mesh or sphere)".into());
-        }
         let cylinder = Cylinder::new(p0, p1, radius, to_world)
             .ok_or("a cylinder needs a positive radius, distinct end points and an invertible transform")?;
+        if emission.is_some() && !(cylinder.area() > 0.0 && cylinder.area().is_finite()) {
+            return Err("an emitting cylinder has no finite area".into());
+        }
         let id = self.cylinders.len() as u32;
         self.cylinders.push(cylinder);
+        let instance = self.instances.len() as u32;
+        // Emits on the side its normal faces, as a sphere.
+        let light = emission.map(|e| {
+            self.lights.push(PendingLight::Ready(Light::Cylinder {
+                instance,
+                cylinder,
+                radiance: e.radiance,
+                inward: flip_normals,
+            }));
+            self.lights.len() as u32 - 1
+        });
         self.instances.push(Instance {
             shape: ShapeRef::Cylinder(id),
             to_world: None,
             material,
-            light: None,
+            light,
             flip_normals,
             bounds: cylinder.bounds(),
             media: MediumBoundary::default(),
@@ -352,7 +363,7 @@ impl WorldBuilder {
         normals: SdfNormals,
         to_world: &Transform,
         material: u32,
-        emission: Option<Emission>,
+        emission: Option<AreaEmission>,
     ) -> Result<(), String> {
         if emission.is_some() {
             return Err("an emitting sdfgrid is not supported (Mitsuba's cannot emit either)".into());

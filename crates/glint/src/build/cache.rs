@@ -10,10 +10,10 @@ use super::builder::{bake, environment_lights, read_mesh_file};
 use super::{add_light, camera, material_id, material_kind, mesh_loc, transform_of, validate, TextureCache};
 use super::{BuildOptions, LoadedGroup, WorldBuilder};
 use crate::accel::BvhSplit;
-use crate::describe::{Geometry, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc, ShapeDesc};
+use crate::describe::{Emission, Geometry, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc, ShapeDesc};
 use crate::error::{Error, SourceLoc};
 use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, SdfNormals, TriangleMesh};
-use crate::lights::Light;
+use crate::lights::{AreaEmission, Light};
 use crate::materials::Material;
 use crate::math::Transform;
 use crate::world::World;
@@ -130,7 +130,8 @@ pub fn build_cached(
     for (index, s) in desc.shapes.iter().enumerate() {
         let first = b.instance_count() as u32;
         let place = Placement { index, instanced: instanced.contains(&index) };
-        add_shape(&mut b, desc, s, &place, &material_ids, cache, &mut used).map_err(|e| e.or_at(&s.loc))?;
+        add_shape(&mut b, desc, s, &place, &material_ids, cache, &mut used, &mut textures)
+            .map_err(|e| e.or_at(&s.loc))?;
         b.set_media_since(first as usize, super::media::boundary(&s.media));
         layout.shape_instances.push(first..b.instance_count() as u32);
     }
@@ -187,6 +188,7 @@ struct Placement {
     instanced: bool,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn add_shape(
     b: &mut WorldBuilder,
     desc: &SceneDesc,
@@ -195,9 +197,11 @@ fn add_shape(
     material_ids: &[u32],
     cache: &mut MeshCache,
     used: &mut Used,
+    textures: &mut TextureCache,
 ) -> Result<(), Error> {
     let to_world = transform_of(&s.to_world)?;
     let material = material_id(b, s.material, material_ids)?;
+    let emission = area_emission(s.emission.as_ref(), textures)?;
     let (source, instanced) = match &s.geometry {
         Geometry::MeshFile { file, face_normals, shape_index } => {
             (Source::File { file: file.clone(), face_normals: *face_normals, shape_index: *shape_index }, false)
@@ -210,10 +214,11 @@ fn add_shape(
         }
         Geometry::Sphere { center, radius } => {
             check_attributes(desc, s, None)?;
-            return Ok(b.add_sphere(*center, *radius, &to_world, material, s.emission, s.flip_normals)?);
+            return Ok(b.add_sphere(*center, *radius, &to_world, material, emission, s.flip_normals)?);
         }
         Geometry::Cylinder { p0, p1, radius } => {
-            return Ok(b.add_cylinder(*p0, *p1, *radius, &to_world, material, s.emission, s.flip_normals)?);
+            check_attributes(desc, s, None)?;
+            return Ok(b.add_cylinder(*p0, *p1, *radius, &to_world, material, emission, s.flip_normals)?);
         }
         Geometry::SdfGrid { file, normals } => {
             check_attributes(desc, s, None)?;
@@ -226,7 +231,7 @@ fn add_shape(
                     },
                     &to_world,
                     material,
-                    s.emission,
+                    emission,
                 )
                 .map_err(|e| Error::at(&s.loc, e));
         }
@@ -258,7 +263,7 @@ fn add_shape(
     for (group, g) in groups.iter().enumerate() {
         let m = if s.use_mtl && !g.material.is_empty() { b.mtl_material(g).unwrap_or(material) } else { material };
         if instanced || to_world.is_identity() {
-            b.add_mesh_instance(&g.mesh, &to_world, instanced, m, s.emission, s.flip_normals)?;
+            b.add_mesh_instance(&g.mesh, &to_world, instanced, m, emission.clone(), s.flip_normals)?;
         } else {
             // Baked here rather than by the builder so that the copy is cached; placed with
             // the identity, exactly as the builder places its own baked copies.
@@ -276,26 +281,40 @@ fn add_shape(
                 }
             };
             used.baked.insert(key);
-            b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, m, s.emission, s.flip_normals)?;
+            b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, m, emission.clone(), s.flip_normals)?;
         }
     }
     Ok(())
 }
 
-/// Every mesh attribute the shape's material reads must be one its mesh has (a sphere has
-/// none), with a value size a texture can use.
+/// What a shape emits, its texture made (or found in the cache).
+fn area_emission(e: Option<&Emission>, textures: &mut TextureCache) -> Result<Option<AreaEmission>, Error> {
+    e.map(|e| Ok(AreaEmission { radiance: textures.texture(&e.radiance)?, two_sided: e.two_sided })).transpose()
+}
+
+/// Every mesh attribute the shape's material and emitted radiance read must be one its mesh
+/// has (spheres and cylinders have none), with a value size a texture can use.
 fn check_attributes(desc: &SceneDesc, s: &ShapeDesc, mesh: Option<&TriangleMesh>) -> Result<(), Error> {
-    let MaterialRef::Index(i) = s.material else { return Ok(()) };
-    let Some(m) = desc.materials.get(i) else { return Ok(()) };
-    for (name, _) in m.model.mesh_attributes() {
+    let material = match s.material {
+        MaterialRef::Index(i) => desc.materials.get(i),
+        _ => None,
+    };
+    let mut reads: Vec<(String, &str)> = Vec::new();
+    if let Some(m) = material {
+        let what = format!("material '{}'", m.name);
+        reads.extend(m.model.mesh_attributes().into_iter().map(|(name, _)| (what.clone(), name)));
+    }
+    if let Some(e) = &s.emission {
+        reads.extend(e.mesh_attributes().into_iter().map(|(name, _)| ("the emitted radiance".to_string(), name)));
+    }
+    for (what, name) in reads {
         if mesh.is_some_and(|mesh| mesh.attribute(name).is_some()) {
             continue;
         }
         let have: Vec<&str> = mesh.map_or(vec![], |m| m.attributes.iter().map(|a| a.name.as_str()).collect());
         let have = if have.is_empty() { "none".to_string() } else { have.join(", ") };
         return Err(Error::new(format!(
-            "material '{}' reads mesh attribute '{name}', which this shape does not have (it has: {have})",
-            m.name
+            "{what} reads mesh attribute '{name}', which this shape does not have (it has: {have})"
         )));
     }
     Ok(())
@@ -357,8 +376,11 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
     let mut emission = Vec::new();
     for (s, instances) in desc.shapes.iter().zip(&layout.shape_instances) {
         for i in instances.clone() {
-            match (world.instances[i as usize].light, s.emission) {
-                (Some(light), Some(e)) => emission.push((light as usize, e)),
+            match (world.instances[i as usize].light, &s.emission) {
+                (Some(light), Some(e)) => {
+                    let e = area_emission(Some(e), &mut textures).map_err(|err| err.or_at(&s.loc))?;
+                    emission.extend(e.map(|e| (light as usize, e)));
+                }
                 (None, None) => {}
                 _ => return Ok(false),
             }
@@ -375,7 +397,7 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
                 *radiance = e.radiance;
                 *two_sided = e.two_sided;
             }
-            Light::Sphere { radiance, .. } => *radiance = e.radiance,
+            Light::Sphere { radiance, .. } | Light::Cylinder { radiance, .. } => *radiance = e.radiance,
             _ => unreachable!("an instance's light is an area light"),
         }
     }

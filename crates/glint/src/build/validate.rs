@@ -64,7 +64,7 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
     for s in &d.shapes {
         matrix(&s.to_world, "to_world").map_err(|m| Error::at(&s.loc, m))?;
         if let Some(e) = &s.emission {
-            color(e.radiance, "emitted radiance").map_err(|m| Error::at(&s.loc, m))?;
+            texture(&e.radiance, "emitted radiance").map_err(|m| Error::at(&s.loc, m))?;
         }
         match &s.geometry {
             Geometry::Sphere { center, radius } => {
@@ -151,25 +151,31 @@ fn camera(c: &CameraDesc) -> Result<(), Error> {
     Ok(())
 }
 
-fn material(m: &MaterialModel) -> Result<(), String> {
-    for t in m.textures() {
-        match t {
-            TextureDesc::Constant { color: c } => color(*c, "colour")?,
-            TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {
-                color(*color0, "color0")?;
-                color(*color1, "color1")?;
-                uv(uv_scale, uv_offset)?;
+/// A texture's colours (named `what` when constant), uv transform and attribute name.
+fn texture(t: &TextureDesc, what: &str) -> Result<(), String> {
+    match t {
+        TextureDesc::Constant { color: c } => color(*c, what)?,
+        TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {
+            color(*color0, "color0")?;
+            color(*color1, "color1")?;
+            uv(uv_scale, uv_offset)?;
+        }
+        TextureDesc::Bitmap { uv_scale, uv_offset, .. } => uv(uv_scale, uv_offset)?,
+        TextureDesc::MeshAttribute { name, scale, .. } => {
+            if !scale.is_finite() {
+                return Err(format!("mesh attribute '{name}': scale {scale} must be finite"));
             }
-            TextureDesc::Bitmap { uv_scale, uv_offset, .. } => uv(uv_scale, uv_offset)?,
-            TextureDesc::MeshAttribute { name, scale, .. } => {
-                if !scale.is_finite() {
-                    return Err(format!("mesh attribute '{name}': scale {scale} must be finite"));
-                }
-                if !(name.starts_with("vertex_") || name.starts_with("face_")) {
-                    return Err(format!("mesh attribute name '{name}' must start with 'vertex_' or 'face_'"));
-                }
+            if !(name.starts_with("vertex_") || name.starts_with("face_")) {
+                return Err(format!("mesh attribute name '{name}' must start with 'vertex_' or 'face_'"));
             }
         }
+    }
+    Ok(())
+}
+
+fn material(m: &MaterialModel) -> Result<(), String> {
+    for t in m.textures() {
+        texture(t, "colour")?;
     }
     let alpha = |r: &Option<crate::describe::Roughness>| -> Result<(), String> {
         let Some(r) = r else { return Ok(()) };

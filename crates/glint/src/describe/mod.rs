@@ -326,10 +326,27 @@ impl ShapeMedia {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// What an area light emits: radiance, a colour or a texture read at the surface's uv (as
+/// Mitsuba's `area` emitter reads its `radiance`), on the side the normal faces or on both.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Emission {
-    pub radiance: Rgb,
+    pub radiance: TextureDesc,
     pub two_sided: bool,
+}
+
+impl Emission {
+    /// A uniform radiance on the front side.
+    pub fn constant(radiance: Rgb) -> Emission {
+        Emission { radiance: TextureDesc::constant(radiance), two_sided: false }
+    }
+
+    /// The mesh attributes the radiance reads (a shape must have them).
+    pub fn mesh_attributes(&self) -> Vec<(&str, &SourceLoc)> {
+        match &self.radiance {
+            TextureDesc::MeshAttribute { name, loc, .. } => vec![(name.as_str(), loc)],
+            _ => vec![],
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -671,7 +688,7 @@ mod tests {
             to_world: IDENTITY,
             material: MaterialRef::DefaultDiffuse,
             use_mtl: false,
-            emission: Some(Emission { radiance: Rgb::splat(2.0), two_sided: false }),
+            emission: Some(Emission::constant(Rgb::splat(2.0))),
             flip_normals: false,
             loc: SourceLoc::new("a.json", 3, 5),
             media: ShapeMedia::default(),

@@ -346,7 +346,7 @@ struct JsonShape {
     #[serde(default)]
     transform: Vec<JsonTransformOp>,
     #[serde(default)]
-    emission: Option<JsonColor>,
+    emission: Option<JsonTexture>,
     #[serde(default)]
     two_sided_emission: bool,
     #[serde(default)]
@@ -943,7 +943,10 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         let at = format!("shapes/{i}");
         let here = |msg: String| ctx.err(&at, format!("shape {i} ({}): {msg}", s.kind));
         let to_world = transform_of(&s.transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?;
-        let emission = s.emission.map(|e| Emission { radiance: e.rgb(), two_sided: s.two_sided_emission });
+        let emission = s.emission.as_ref().map(|e| Emission {
+            radiance: texture_of(&ctx, &format!("{at}/emission"), e),
+            two_sided: s.two_sided_emission,
+        });
         let material =
             match &s.material {
                 Some(name) => MaterialRef::Index(desc.material_index(name).ok_or_else(|| {

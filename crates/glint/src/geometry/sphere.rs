@@ -30,6 +30,18 @@ impl Sphere {
         self.axes[0] * l.x + self.axes[1] * l.y + self.axes[2] * l.z
     }
 
+    /// Mitsuba's uv of the point with unit outward normal `n` (world): u the azimuth over 2π
+    /// about the sphere's own z axis from its +x, v the polar angle over π from its +z.
+    pub fn uv(&self, n: Vec3) -> [f32; 2] {
+        let local = self.to_local(n);
+        let theta = local.z.clamp(-1.0, 1.0).acos();
+        let mut phi = local.y.atan2(local.x);
+        if phi < 0.0 {
+            phi += 2.0 * std::f32::consts::PI;
+        }
+        [phi / (2.0 * std::f32::consts::PI), theta / std::f32::consts::PI]
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb { min: self.center - Vec3::splat(self.radius), max: self.center + Vec3::splat(self.radius) }
     }

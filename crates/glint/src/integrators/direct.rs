@@ -34,10 +34,8 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                 .fold(l, |l, &i| l + scene.lights[i as usize].environment(camera_ray.dir));
         };
         let si = scene.interaction(&ray, &hit);
-        if let Some(li_idx) = si.light {
-            // Only reached when emitters are shown (`camera_hit` looks through them otherwise).
-            l += scene.lights[li_idx as usize].emitted(si.ng, ray.dir);
-        }
+        // Only reached when emitters are shown (`camera_hit` looks through them otherwise).
+        l += scene.emitted(&si, ray.dir);
         if scene.has_masks && passes < MAX_MASK_PASSES {
             let o = opacity(scene, &si);
             if o < 1.0 && rng.next_f32() >= o {
@@ -110,7 +108,7 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                     let sj = scene.interaction(&ray, &hit);
                     if let Some(li_idx) = sj.light {
                         let light = &scene.lights[li_idx as usize];
-                        let le = light.emitted(sj.ng, ray.dir);
+                        let le = scene.emitted(&sj, ray.dir);
                         if !le.is_black() {
                             let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, sj.p, sj.ng);
                             l += weight(light_pdf) * le * through;

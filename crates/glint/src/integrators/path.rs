@@ -68,7 +68,7 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
         if let Some(li_idx) = si.light {
             if !(depth == 1 && s.hide_emitters) {
                 let light = &scene.lights[li_idx as usize];
-                let le = light.emitted(si.ng, ray.dir);
+                let le = scene.emitted(&si, ray.dir);
                 if !le.is_black() {
                     let w = emitter_weight(s.strategy, prev_delta, prev_pdf, || {
                         scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, si.p, si.ng)

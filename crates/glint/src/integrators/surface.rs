@@ -5,7 +5,7 @@ use super::Counters;
 use crate::bsdf::{flip_invalid, normal_map_frame, ShadedBsdf};
 use crate::materials::{Perturbation, TexturePoint};
 use crate::math::{offset_origin, Frame, Ray, Vec3};
-use crate::world::{ShapeRef, SurfaceInteraction, World};
+use crate::world::{SurfaceInteraction, World};
 
 /// The most masked surfaces one ray passes through; a ray that meets more (a stack of
 /// coincident cut-outs) stops at the next one, as if it were opaque.
@@ -13,11 +13,7 @@ pub(crate) const MAX_MASK_PASSES: u32 = 256;
 
 /// Where textures are looked up for `si`.
 pub(crate) fn texture_point<'a>(scene: &'a World, si: &SurfaceInteraction) -> TexturePoint<'a> {
-    let mesh = scene.instances.get(si.instance as usize).and_then(|inst| match inst.shape {
-        ShapeRef::Mesh(m) => scene.meshes.get(m as usize).map(|m| &**m),
-        ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) => None,
-    });
-    TexturePoint { uv: si.uv, prim: si.prim, bary: si.bary, mesh }
+    scene.texture_point(si)
 }
 
 /// The probability that light meeting the surface at `si` scatters there (1 unless masked).

@@ -130,7 +130,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
                 continue;
             }
             let light = &scene.lights[li_idx as usize];
-            let le = light.emitted(si.ng, ray.dir);
+            let le = scene.emitted(&si, ray.dir);
             if !le.is_black() {
                 let w = emitter_weight(prev_delta, prev_pdf, || {
                     scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, si.p, si.ng)

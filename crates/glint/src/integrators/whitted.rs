@@ -111,9 +111,7 @@ fn shade(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
     let si = scene.interaction(ray, &hit);
     let wo_world = -ray.dir;
     let mut l = Rgb::BLACK;
-    if let Some(li) = si.light {
-        l += scene.lights[li as usize].emitted(si.ng, ray.dir);
-    }
+    l += scene.emitted(&si, ray.dir);
     let (bsdf, frame) = shading(scene, &si, wo_world);
     let wo = frame.to_local(wo_world);
     let can_recurse = depth < s.max_depth;
@@ -171,8 +169,8 @@ mod tests {
     use crate::accel::BvhSplit;
     use crate::build::WorldBuilder;
     use crate::camera::{Camera, FovAxis};
-    use crate::describe::Emission;
     use crate::geometry::quad_mesh;
+    use crate::lights::AreaEmission;
     use crate::lights::LightSelection;
     use crate::materials::{Material, MaterialKind, Texture};
     use crate::math::{vec3, Transform, Vec3};
@@ -198,9 +196,7 @@ mod tests {
         let si = scene.interaction(ray, &hit);
         let wo_world = -ray.dir;
         let mut l = Rgb::BLACK;
-        if let Some(li) = si.light {
-            l += scene.lights[li as usize].emitted(si.ng, ray.dir);
-        }
+        l += scene.emitted(&si, ray.dir);
         let (bsdf, frame) = shading(scene, &si, wo_world);
         let wo = frame.to_local(wo_world);
         let can_recurse = depth < s.max_depth;
@@ -268,7 +264,7 @@ mod tests {
             MaterialKind::Dielectric { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
             false,
         ));
-        let quad = |b: &mut WorldBuilder, p: [Vec3; 4], m: u32, e: Option<Emission>| {
+        let quad = |b: &mut WorldBuilder, p: [Vec3; 4], m: u32, e: Option<AreaEmission>| {
             let mesh = Arc::new(quad_mesh(p, BvhSplit::Sah));
             b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, m, e, false).unwrap();
         };
@@ -276,7 +272,7 @@ mod tests {
         quad(&mut b, [vec3(-a, 0.0, a), vec3(a, 0.0, a), vec3(a, 0.0, z), vec3(-a, 0.0, z)], white, None);
         quad(&mut b, [vec3(-a, 0.0, z), vec3(a, 0.0, z), vec3(a, 3.0, z), vec3(-a, 3.0, z)], mirror, None);
         let light = b.black_material();
-        let e = Some(Emission { radiance: Rgb::splat(10.0), two_sided: false });
+        let e = Some(AreaEmission::constant(Rgb::splat(10.0)));
         quad(
             &mut b,
             [vec3(-0.5, 2.9, -0.5), vec3(-0.5, 2.9, 0.5), vec3(0.5, 2.9, 0.5), vec3(0.5, 2.9, -0.5)],

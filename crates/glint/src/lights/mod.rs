@@ -5,6 +5,13 @@
 //!   the light), so that multiple importance sampling can weigh the two;
 //! - `power()`: an estimate of emitted flux, for choosing among lights.
 //!
+//! Area lights emit a radiance texture read at the surface's uv (Mitsuba's `area` emitter
+//! with a textured `radiance`). Their points are sampled by the shape's geometry alone (by
+//! solid angle where the shape allows it, by area otherwise) and the texture is read at the
+//! point sampled, so light sampling and rays that hit the light weigh the same radiance;
+//! Mitsuba samples a spatially varying radiance by the texture instead, which converges to
+//! the same image. Their power (for light selection) uses the texture's mean.
+//!
 //! Delta lights (point, spot, directional) have a density of 1 by convention and are never
 //! hit by BSDF-sampled rays.
 
@@ -20,7 +27,8 @@ pub use selection::LightSelection;
 
 use rectangle::SphericalRectangle;
 
-use crate::geometry::Sphere;
+use crate::geometry::{Cylinder, Sphere, TriangleMesh};
+use crate::materials::{Texture, TexturePoint};
 use crate::math::{Aabb, Frame, Rgb, Vec3, PI};
 use crate::sampling::{warp, Distribution1d};
 use std::sync::Arc;
@@ -38,6 +46,44 @@ pub struct LightSample {
     pub delta: bool,
 }
 
+/// What an area light emits (see the module doc): a radiance texture on the front side (the
+/// way the normal faces) or on both.
+#[derive(Clone, Debug)]
+pub struct AreaEmission {
+    pub radiance: Texture,
+    pub two_sided: bool,
+}
+
+impl AreaEmission {
+    /// A uniform radiance on the front side.
+    pub fn constant(radiance: Rgb) -> AreaEmission {
+        AreaEmission { radiance: Texture::Constant(radiance), two_sided: false }
+    }
+}
+
+/// The radiance a texture gives at a point found by `at` (only looked for when the texture
+/// varies).
+#[inline]
+fn radiance_at<'a>(t: &Texture, at: impl FnOnce() -> TexturePoint<'a>) -> Rgb {
+    match t {
+        Texture::Constant(c) => *c,
+        t => t.eval_at(&at()),
+    }
+}
+
+/// Barycentrics (b1, b2) of `q` in the triangle `[a, b, c]` (q = a + b1 (b - a) + b2 (c - a)
+/// when q lies in its plane).
+fn barycentric([a, b, c]: [Vec3; 3], q: Vec3) -> [f32; 2] {
+    let (e1, e2, d) = (b - a, c - a, q - a);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d1, d2) = (d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    if !(det > 0.0) {
+        return [0.0, 0.0];
+    }
+    [(d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det]
+}
+
 /// A triangle-mesh emitter, with its triangles in world space and a distribution
 /// proportional to their area (the paper's choice: pick a triangle by area, then a uniform
 /// point on it). A mesh that is one rectangle is sampled by solid angle instead, from the
@@ -49,6 +95,11 @@ pub struct MeshEmitter {
     pub areas: Distribution1d,
     pub total_area: f32,
     pub rectangle: Option<Rectangle>,
+    /// The mesh the triangles were made from (triangle `i` is its triangle `i`), for the uvs
+    /// and attributes a radiance texture reads; `None`: uvs are the barycentrics.
+    pub mesh: Option<Arc<TriangleMesh>>,
+    /// The triangles' second and third corners are swapped from the mesh's (flipped normals).
+    pub flipped: bool,
 }
 
 impl MeshEmitter {
@@ -58,7 +109,44 @@ impl MeshEmitter {
         let total_area = areas.iter().sum();
         let areas = Distribution1d::new(&areas)?;
         let rectangle = Rectangle::from_triangles(&triangles);
-        Some(MeshEmitter { triangles, areas, total_area, rectangle })
+        Some(MeshEmitter { triangles, areas, total_area, rectangle, mesh: None, flipped: false })
+    }
+
+    /// The emitter of `mesh`'s triangles, given in world space (with their second and third
+    /// corners swapped when `flipped`).
+    pub fn of_mesh(triangles: Vec<[Vec3; 3]>, mesh: Arc<TriangleMesh>, flipped: bool) -> Option<MeshEmitter> {
+        let e = MeshEmitter::new(triangles)?;
+        Some(MeshEmitter { mesh: Some(mesh), flipped, ..e })
+    }
+
+    /// Where a texture is read at the point of barycentrics `e` (in the emitter's corner
+    /// order) on triangle `tri`: the mesh's interpolated uv, as a hit there reads it.
+    fn texture_point(&self, tri: usize, e: [f32; 2]) -> TexturePoint<'_> {
+        let bary = if self.flipped { [e[1], e[0]] } else { e };
+        let Some(mesh) = self.mesh.as_deref() else { return TexturePoint::uv(bary) };
+        let uv = match (mesh.uvs.as_ref(), mesh.indices.get(tri)) {
+            (Some(t), Some(&[i0, i1, i2])) => {
+                let (t0, t1, t2) = (t[i0 as usize], t[i1 as usize], t[i2 as usize]);
+                let b0 = 1.0 - bary[0] - bary[1];
+                [t0[0] * b0 + t1[0] * bary[0] + t2[0] * bary[1], t0[1] * b0 + t1[1] * bary[0] + t2[1] * bary[1]]
+            }
+            _ => bary,
+        };
+        TexturePoint { uv, prim: tri as u32, bary, mesh: Some(mesh) }
+    }
+
+    /// The triangle holding `q` (a point of the emitter) and its barycentrics there: the
+    /// triangle `q` lies deepest inside.
+    fn locate(&self, q: Vec3) -> (usize, [f32; 2]) {
+        let mut best = (0, [0.0, 0.0], f32::NEG_INFINITY);
+        for (i, t) in self.triangles.iter().enumerate() {
+            let b = barycentric(*t, q);
+            let inside = b[0].min(b[1]).min(1.0 - b[0] - b[1]);
+            if inside > best.2 {
+                best = (i, b, inside);
+            }
+        }
+        (best.0, best.1)
     }
 
     /// Whether light samples seen from `p` are drawn by solid angle (otherwise by area).
@@ -97,15 +185,23 @@ pub enum Light {
     Mesh {
         instance: u32,
         emitter: Arc<MeshEmitter>,
-        radiance: Rgb,
+        radiance: Texture,
         two_sided: bool,
     },
     /// Area light on a sphere; sampled by the solid angle it subtends.
     Sphere {
         instance: u32,
         sphere: Sphere,
-        radiance: Rgb,
+        radiance: Texture,
         /// Normals flipped: the sphere emits into its inside only (otherwise outside only).
+        inward: bool,
+    },
+    /// Area light on an open cylinder; sampled uniformly by area (as Mitsuba samples it).
+    Cylinder {
+        instance: u32,
+        cylinder: Cylinder,
+        radiance: Texture,
+        /// Normals flipped: the tube emits towards its axis only (otherwise outward only).
         inward: bool,
     },
     /// Uniform radiance from every direction.
@@ -133,6 +229,7 @@ impl Light {
         match self {
             Light::Mesh { emitter, .. } => emitter.total_area,
             Light::Sphere { sphere, .. } => sphere.area(),
+            Light::Cylinder { cylinder, .. } => cylinder.area(),
             _ => 0.0,
         }
     }
@@ -151,9 +248,10 @@ impl Light {
             }
             Light::Mesh { emitter, radiance, two_sided, .. } => {
                 let sides = if *two_sided { 2.0 } else { 1.0 };
-                sides * PI * emitter.total_area * radiance.luminance()
+                sides * PI * emitter.total_area * radiance.mean().luminance()
             }
-            Light::Sphere { sphere, radiance, .. } => PI * sphere.area() * radiance.luminance(),
+            Light::Sphere { sphere, radiance, .. } => PI * sphere.area() * radiance.mean().luminance(),
+            Light::Cylinder { cylinder, radiance, .. } => PI * cylinder.area() * radiance.mean().luminance(),
             Light::Constant { radiance, scene_radius } => {
                 4.0 * PI * PI * scene_radius * scene_radius * radiance.luminance()
             }
@@ -189,8 +287,8 @@ impl Light {
             }
             Light::Mesh { emitter, radiance, two_sided, .. } => {
                 let by_solid_angle = emitter.spherical_rectangle(p);
-                let (q, n) = match &by_solid_angle {
-                    Some(sr) => (sr.sample(u), emitter.rectangle.as_ref()?.normal),
+                let (q, n, at) = match &by_solid_angle {
+                    Some(sr) => (sr.sample(u), emitter.rectangle.as_ref()?.normal, None),
                     // A rectangle by area: the square mapped linearly onto it, as Mitsuba's
                     // `rectangle` does, so a stratified `u` stays stratified along both edges.
                     // (Picking one of its two triangles with `u[0]` left each triangle, which
@@ -198,13 +296,14 @@ impl Light {
                     // of Mitsuba's at 16 spp.) Same density: uniform over the same area.
                     None if emitter.rectangle.is_some() => {
                         let r = emitter.rectangle.as_ref()?;
-                        (r.corner + r.ex * u[0] + r.ey * u[1], r.normal)
+                        (r.corner + r.ex * u[0] + r.ey * u[1], r.normal, None)
                     }
                     None => {
                         let pick = emitter.areas.sample(u[0]);
                         let [a, b, c] = emitter.triangles[pick.index];
                         let bary = warp::uniform_triangle([pick.remapped, u[1]]);
-                        (a * (1.0 - bary[0] - bary[1]) + b * bary[0] + c * bary[1], (b - a).cross(c - a).normalize())
+                        let q = a * (1.0 - bary[0] - bary[1]) + b * bary[0] + c * bary[1];
+                        (q, (b - a).cross(c - a).normalize(), Some((pick.index, bary)))
                     }
                 };
                 let d = q - p;
@@ -222,9 +321,38 @@ impl Light {
                     Some(sr) => sr.pdf(),
                     None => dist2 / (cos_l.abs() * emitter.total_area),
                 };
-                Some(LightSample { wi, radiance: *radiance, pdf, dist, delta: false })
+                let radiance = radiance_at(radiance, || {
+                    let (tri, bary) = at.unwrap_or_else(|| emitter.locate(q));
+                    emitter.texture_point(tri, bary)
+                });
+                Some(LightSample { wi, radiance, pdf, dist, delta: false })
             }
-            Light::Sphere { sphere, radiance, inward, .. } => sphere::sample(sphere, *radiance, *inward, p, u),
+            Light::Sphere { sphere, radiance, inward, .. } => {
+                let mut ls = sphere::sample(sphere, Rgb::WHITE, *inward, p, u)?;
+                ls.radiance = radiance_at(radiance, || {
+                    let n = (p + ls.wi * ls.dist - sphere.center).normalize();
+                    TexturePoint::uv(sphere.uv(n))
+                });
+                Some(ls)
+            }
+            Light::Cylinder { cylinder, radiance, inward, .. } => {
+                let q = cylinder.sample(u);
+                let n = if *inward { -q.n } else { q.n };
+                let d = q.p - p;
+                let dist2 = d.length_squared();
+                if !(dist2 > 0.0) {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos_l = -n.dot(wi);
+                if !(cos_l > 0.0) {
+                    return None;
+                }
+                let pdf = dist2 / (cos_l * cylinder.area());
+                let radiance = radiance_at(radiance, || TexturePoint::uv(q.uv));
+                Some(LightSample { wi, radiance, pdf, dist, delta: false })
+            }
             Light::Constant { radiance, .. } => {
                 let wi = warp::uniform_sphere(u);
                 Some(LightSample {
@@ -256,31 +384,31 @@ impl Light {
                 dist2 / (cos_l * emitter.total_area)
             }
             Light::Sphere { sphere, .. } => sphere::pdf(sphere, p, q, n, wi),
+            Light::Cylinder { cylinder, .. } => {
+                let cos_l = n.dot(wi).abs();
+                if cos_l == 0.0 {
+                    return 0.0;
+                }
+                (q - p).length_squared() / (cos_l * cylinder.area())
+            }
             Light::Constant { .. } => warp::UNIFORM_SPHERE_PDF,
             Light::EnvMap(env) => env.pdf(wi),
             _ => 0.0,
         }
     }
 
-    /// Radiance leaving an area light at a point with geometric normal `n` towards `-wi`
-    /// (`wi` is the direction the ray travelled).
-    pub fn emitted(&self, n: Vec3, wi: Vec3) -> Rgb {
-        match self {
-            Light::Mesh { radiance, two_sided, .. } => {
-                if *two_sided || n.dot(wi) < 0.0 {
-                    *radiance
-                } else {
-                    Rgb::BLACK
-                }
-            }
-            Light::Sphere { radiance, .. } => {
-                if n.dot(wi) < 0.0 {
-                    *radiance
-                } else {
-                    Rgb::BLACK
-                }
-            }
-            _ => Rgb::BLACK,
+    /// Radiance leaving an area light at the point `at` (where its texture is read), of
+    /// geometric normal `n`, towards `-wi` (`wi` is the direction the ray travelled).
+    pub fn emitted(&self, at: &TexturePoint, n: Vec3, wi: Vec3) -> Rgb {
+        let (radiance, two_sided) = match self {
+            Light::Mesh { radiance, two_sided, .. } => (radiance, *two_sided),
+            Light::Sphere { radiance, .. } | Light::Cylinder { radiance, .. } => (radiance, false),
+            _ => return Rgb::BLACK,
+        };
+        if two_sided || n.dot(wi) < 0.0 {
+            radiance_at(radiance, || *at)
+        } else {
+            Rgb::BLACK
         }
     }
 
@@ -321,7 +449,7 @@ mod tests {
     #[test]
     fn sphere_lights_are_sampled_only_from_the_side_they_light() {
         let sphere = Sphere::new(Vec3::ZERO, 1.0);
-        let light = |inward| Light::Sphere { instance: 0, sphere, radiance: Rgb::WHITE, inward };
+        let light = |inward| Light::Sphere { instance: 0, sphere, radiance: Texture::Constant(Rgb::WHITE), inward };
         let (outside, inside) = (vec3(0.0, 0.0, 3.0), vec3(0.2, 0.1, 0.0));
         for u in [[0.1, 0.2], [0.5, 0.5], [0.9, 0.7]] {
             assert!(light(false).sample_li(outside, u).is_some());
@@ -336,7 +464,12 @@ mod tests {
         let (a, b, c, d) = (vec3(-1.0, -0.1, 2.8), vec3(1.0, -0.1, 2.8), vec3(1.0, 0.1, 2.8), vec3(-1.0, 0.1, 2.8));
         let emitter = MeshEmitter::new(vec![[a, c, b], [a, d, c]]).unwrap();
         assert!(emitter.rectangle.is_some());
-        Light::Mesh { instance: 0, emitter: Arc::new(emitter), radiance: Rgb::WHITE, two_sided: false }
+        Light::Mesh {
+            instance: 0,
+            emitter: Arc::new(emitter),
+            radiance: Texture::Constant(Rgb::WHITE),
+            two_sided: false,
+        }
     }
 
     #[test]

@@ -13,7 +13,9 @@
 
 use super::Session;
 use crate::build::{patch_appearance, BuildCounters};
-use crate::describe::{limits, LightKind, MaterialModel, Matrix4, Roughness, ScalarTexture, SceneDesc, TextureDesc};
+use crate::describe::{
+    limits, Emission, LightKind, MaterialModel, Matrix4, Roughness, ScalarTexture, SceneDesc, TextureDesc,
+};
 use crate::error::Error;
 use crate::math::Rgb;
 use std::sync::Arc;
@@ -186,8 +188,9 @@ fn slots(desc: &mut SceneDesc) -> Vec<(String, Slot<'_>, Effect)> {
         }
     }
     for (i, s) in desc.shapes.iter_mut().enumerate() {
-        if let Some(e) = &mut s.emission {
-            out.push((format!("shapes.{i}.emission"), Slot::Color(&mut e.radiance), Effect::Appearance));
+        // A uniform emitted radiance is editable (a textured one, as a material's texture, not).
+        if let Some(Emission { radiance: TextureDesc::Constant { color }, .. }) = &mut s.emission {
+            out.push((format!("shapes.{i}.emission"), Slot::Color(color), Effect::Appearance));
         }
         out.push((format!("shapes.{i}.to_world"), Slot::Matrix(&mut s.to_world), Effect::Transform(i)));
     }

@@ -11,8 +11,8 @@ use crate::accel::{BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{Cylinder, SdfGrid, Sphere, TriangleMesh};
 use crate::lights::{Light, LightSelection};
-use crate::materials::Material;
-use crate::math::{Aabb, Frame, Ray, Transform, Vec3};
+use crate::materials::{Material, TexturePoint};
+use crate::math::{Aabb, Frame, Ray, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
 use crate::sampling::Distribution1d;
 use std::sync::Arc;
@@ -276,6 +276,25 @@ impl World {
     }
 
     /// The full surface interaction for a hit found along `ray`.
+    /// Where textures are looked up for `si`: its uv, and for meshes the triangle, its
+    /// barycentrics and the mesh (for mesh attributes).
+    pub fn texture_point(&self, si: &SurfaceInteraction) -> TexturePoint<'_> {
+        let mesh = self.instances.get(si.instance as usize).and_then(|inst| match inst.shape {
+            ShapeRef::Mesh(m) => self.meshes.get(m as usize).map(|m| &**m),
+            ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) => None,
+        });
+        TexturePoint { uv: si.uv, prim: si.prim, bary: si.bary, mesh }
+    }
+
+    /// Radiance the surface at `si` emits back along a ray that travelled along `wi` (black
+    /// unless it is an area light, read at its texture point).
+    pub fn emitted(&self, si: &SurfaceInteraction, wi: Vec3) -> Rgb {
+        match si.light.and_then(|l| self.lights.get(l as usize)) {
+            Some(light) => light.emitted(&self.texture_point(si), si.ng, wi),
+            None => Rgb::BLACK,
+        }
+    }
+
     pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
         let inst = &self.instances[hit.instance as usize];
         let (p, mut ng, mut ns, uv, dpdu, dpdv) = match inst.shape {
@@ -320,15 +339,9 @@ impl World {
                 let n = (p - sph.center) / sph.radius;
                 // Re-project onto the surface to remove the error of the root.
                 p = sph.center + n * sph.radius;
-                let local = sph.to_local(n);
-                let theta = local.z.clamp(-1.0, 1.0).acos();
-                let mut phi = local.y.atan2(local.x);
-                if phi < 0.0 {
-                    phi += 2.0 * std::f32::consts::PI;
-                }
-                let (dpdu, dpdv) = sphere_dpduv(local, sph.radius);
+                let (dpdu, dpdv) = sphere_dpduv(sph.to_local(n), sph.radius);
                 let (dpdu, dpdv) = (sph.to_world(dpdu), sph.to_world(dpdv));
-                (p, n, None, [phi / (2.0 * std::f32::consts::PI), theta / std::f32::consts::PI], dpdu, dpdv)
+                (p, n, None, sph.uv(n), dpdu, dpdv)
             }
             ShapeRef::Cylinder(c) => {
                 let q = self.cylinders[c as usize].point(ray, hit.t);

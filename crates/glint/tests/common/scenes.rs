@@ -4,10 +4,9 @@ use glint::accel::BvhSplit;
 use glint::bsdf::{Microfacet, MicrofacetKind};
 use glint::build::WorldBuilder;
 use glint::camera::{Camera, FovAxis};
-use glint::describe::Emission;
 use glint::geometry::{cube_mesh, quad_mesh};
 use glint::integrators::{Integrator, PathSettings, Strategy};
-use glint::lights::LightSelection;
+use glint::lights::{AreaEmission, LightSelection};
 use glint::materials::{Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::render::{render, PixelFilter, RenderOutput, RenderSettings, Silent};
@@ -45,8 +44,8 @@ pub fn render_with(scene: &World, integrator: &Integrator, spp: u32, seed: u64) 
     out
 }
 
-pub fn emission(radiance: f32) -> Option<Emission> {
-    Some(Emission { radiance: Rgb::splat(radiance), two_sided: false })
+pub fn emission(radiance: f32) -> Option<AreaEmission> {
+    Some(AreaEmission::constant(Rgb::splat(radiance)))
 }
 
 /// A diffuse material, scattering on both faces.
@@ -75,7 +74,7 @@ pub fn rough_mirror(b: &mut WorldBuilder, name: &str, alpha: f32) -> u32 {
 
 /// The quad p0 p1 p2 p3; its face (and, when it emits, its emission) points along
 /// (p1 - p0) × (p2 - p0).
-pub fn add_quad(b: &mut WorldBuilder, p: [Vec3; 4], material: u32, emission: Option<Emission>) {
+pub fn add_quad(b: &mut WorldBuilder, p: [Vec3; 4], material: u32, emission: Option<AreaEmission>) {
     let mesh = Arc::new(quad_mesh(p, BvhSplit::Sah));
     b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, material, emission, false).unwrap();
 }
@@ -89,7 +88,7 @@ pub fn add_square(
     sign: f32,
     half: f32,
     material: u32,
-    e: Option<Emission>,
+    e: Option<AreaEmission>,
 ) {
     let mut t1 = [0.0f32; 3];
     t1[(axis + 1) % 3] = half;

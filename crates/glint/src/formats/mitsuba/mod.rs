@@ -495,11 +495,6 @@ impl<'a> Reader<'a> {
             };
             self.note(result);
         }
-        if ty == "cylinder" && emission.is_some() {
-            self.note::<()>(
-                Err(el.err("an emitting cylinder is not supported (give the emitter to a mesh or sphere)")),
-            );
-        }
         if ty == "sdfgrid" {
             if emission.is_some() {
                 self.note::<()>(Err(el.err("an sdfgrid cannot emit light (as in Mitsuba)")));
@@ -601,11 +596,12 @@ impl<'a> Reader<'a> {
             )));
         }
         let ep = Props::new(c);
-        if ep.find("radiance").and_then(|e| self.resolve(e).ok()).is_some_and(|e| e.tag == "texture") {
-            return Err(c.err("area: a textured 'radiance' is not supported (give a colour)"));
-        }
-        let emission =
-            Emission { radiance: ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?, two_sided: false };
+        // A colour, or any texture glint reads, taken at the surface's uv as Mitsuba does.
+        let radiance = match ep.find("radiance").map(|e| self.resolve(e)).transpose()? {
+            Some(e) if e.tag == "texture" => self.texture_element(e)?,
+            _ => TextureDesc::constant(ep.rgb_as("radiance", Rgb::WHITE, SpectrumUse::Emission)?),
+        };
+        let emission = Emission { radiance, two_sided: false };
         self.warn_unused(&ep);
         Ok(emission)
     }
