@@ -1,9 +1,12 @@
 //! Media of a description: checked (every number finite and in range, every index in
 //! bounds) and turned into the world's [`Medium`]s.
 
-use crate::describe::{MediumDesc, PhaseDesc, SceneDesc};
+use crate::describe::{GridVolumeDesc, MediumDesc, PhaseDesc, SceneDesc, VolumeDesc};
 use crate::error::{Error, SourceLoc};
-use crate::media::{Medium, MediumBoundary, Phase};
+use crate::io::vol::read_vol;
+use crate::math::{Mat4, Transform};
+use crate::media::{Albedo, GridVolume, Medium, MediumBoundary, Phase};
+use std::sync::Arc;
 
 /// The largest extinction (per unit length, after `scale`) a medium may have: denser ones
 /// would make paths of billions of tiny steps.
@@ -38,8 +41,17 @@ fn medium(m: &MediumDesc) -> Result<(), String> {
             ));
         }
     }
-    if !m.albedo.to_array().iter().all(|a| (0.0..=1.0).contains(a)) {
-        return Err(format!("albedo ({}, {}, {}) must lie in [0, 1]", m.albedo.r, m.albedo.g, m.albedo.b));
+    match &m.albedo {
+        VolumeDesc::Constant(a) => {
+            if !a.to_array().iter().all(|a| (0.0..=1.0).contains(a)) {
+                return Err(format!("albedo ({}, {}, {}) must lie in [0, 1]", a.r, a.g, a.b));
+            }
+        }
+        VolumeDesc::Grid(g) => {
+            if Transform::from_matrix(Mat4(g.to_world)).is_none_or(|t| !t.is_finite()) {
+                return Err("the albedo grid's to_world must be finite and invertible".into());
+            }
+        }
     }
     if let PhaseDesc::Hg { g } = m.phase {
         if !(g > -1.0 && g < 1.0) {
@@ -49,8 +61,9 @@ fn medium(m: &MediumDesc) -> Result<(), String> {
     Ok(())
 }
 
-/// The world's media, in the description's order (checked first by [`check`]).
-pub fn media(d: &SceneDesc) -> Vec<Medium> {
+/// The world's media, in the description's order (checked first by [`check`]); grid
+/// volumes are read here.
+pub fn media(d: &SceneDesc) -> Result<Vec<Medium>, Error> {
     d.media
         .iter()
         .map(|m| {
@@ -58,9 +71,38 @@ pub fn media(d: &SceneDesc) -> Vec<Medium> {
                 PhaseDesc::Isotropic => Phase::Isotropic,
                 PhaseDesc::Hg { g } => Phase::HenyeyGreenstein { g },
             };
-            Medium::new(m.sigma_t * m.scale, m.albedo, phase, m.sample_emitters)
+            let albedo = match &m.albedo {
+                VolumeDesc::Constant(a) => Albedo::Constant(*a),
+                VolumeDesc::Grid(g) => Albedo::Grid(Arc::new(
+                    albedo_grid(g).map_err(|e| Error::at(&g.loc, format!("medium '{}': albedo: {e}", m.name)))?,
+                )),
+            };
+            Ok(Medium::new(m.sigma_t * m.scale, albedo, phase, m.sample_emitters))
         })
         .collect()
+}
+
+/// Reads an albedo grid: 1 or 3 channels, every value in [0, 1].
+fn albedo_grid(g: &GridVolumeDesc) -> Result<GridVolume, String> {
+    let grid = read_vol(&g.file)?;
+    let file = g.file.display();
+    if !matches!(grid.channels, 1 | 3) {
+        return Err(format!("{file}: a grid of {} channels cannot be an albedo (1 or 3 channels are)", grid.channels));
+    }
+    if let Some(i) = grid.data.iter().position(|v| !(0.0..=1.0).contains(v)) {
+        let cell = i / grid.channels as usize;
+        let [rx, ry, _] = grid.resolution.map(|r| r as usize);
+        return Err(format!(
+            "{file}: albedo {} in cell ({}, {}, {}) must lie in [0, 1]",
+            grid.data[i],
+            cell % rx,
+            cell / rx % ry,
+            cell / (rx * ry)
+        ));
+    }
+    let to_world = Transform::from_matrix(Mat4(g.to_world)).ok_or("the grid's to_world is not invertible")?;
+    GridVolume::new(grid.resolution, grid.channels, grid.data, g.filter, g.wrap, to_world)
+        .ok_or_else(|| format!("{file}: the grid's size does not match its resolution"))
 }
 
 /// The media on the two sides of a shape, as the world indexes them.

@@ -67,7 +67,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
         if let Some(mi) = medium {
             let m = &scene.media[mi as usize];
             let t_max = hit.map_or(f32::INFINITY, |h| h.t);
-            let flight = sample_distance(m, t_max, channel, rng.next_f32());
+            let flight = sample_distance(m, &ray, t_max, channel, rng.next_f32());
             let mean = (density_ratio * flight.density).average();
             if !(mean > 0.0) {
                 break;

@@ -6,25 +6,52 @@
 //! normal, `exterior` in front), and a ray crossing such a shape enters the medium on the
 //! side it goes to. The camera names the medium it starts in.
 
+mod grid;
 mod phase;
+pub use grid::GridVolume;
 pub use phase::{Phase, PhaseSample};
 
-use crate::math::Rgb;
+use crate::math::{Ray, Rgb, Vec3};
+use std::sync::Arc;
 
-/// A homogeneous medium: constant extinction and scattering coefficients (per unit length).
+/// A homogeneous medium: constant extinction (per unit length), and an albedo that is
+/// constant or varies through space (a grid volume): the scattering coefficient at a point
+/// is `sigma_t * albedo(p)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Medium {
     pub sigma_t: Rgb,
-    /// Scattering coefficient, `albedo * sigma_t`; at most `sigma_t`.
-    pub sigma_s: Rgb,
+    pub albedo: Albedo,
     pub phase: Phase,
     /// Next-event estimation from scattering points in this medium.
     pub sample_emitters: bool,
 }
 
+/// A medium's single-scattering albedo.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Albedo {
+    Constant(Rgb),
+    Grid(Arc<GridVolume>),
+}
+
+impl Albedo {
+    #[inline]
+    pub fn at(&self, p: Vec3) -> Rgb {
+        match self {
+            Albedo::Constant(a) => *a,
+            Albedo::Grid(g) => g.eval(p),
+        }
+    }
+}
+
 impl Medium {
-    pub fn new(sigma_t: Rgb, albedo: Rgb, phase: Phase, sample_emitters: bool) -> Medium {
-        Medium { sigma_t, sigma_s: sigma_t * albedo, phase, sample_emitters }
+    pub fn new(sigma_t: Rgb, albedo: Albedo, phase: Phase, sample_emitters: bool) -> Medium {
+        Medium { sigma_t, albedo, phase, sample_emitters }
+    }
+
+    /// The scattering coefficient at world point `p`.
+    #[inline]
+    pub fn sigma_s(&self, p: Vec3) -> Rgb {
+        self.sigma_t * self.albedo.at(p)
     }
 
     /// The fraction of light that crosses a distance `t` unscattered, per channel.
@@ -83,16 +110,17 @@ pub struct FreeFlight {
     pub density: Rgb,
 }
 
-/// Samples a free-flight distance from channel `channel`'s exponential (`u` uniform in
-/// [0, 1); `t_max` the distance to the next surface). The volumetric path tracer weights the
+/// Samples a free-flight distance along `ray` from channel `channel`'s exponential (`u`
+/// uniform in [0, 1); `t_max` the distance to the next surface); the albedo is looked up
+/// where the ray scatters. The volumetric path tracer weights the
 /// path by the mean of the channels' path densities (spectral MIS), so that the estimate is
 /// unbiased in every channel whichever channel drew the distances.
-pub fn sample_distance(m: &Medium, t_max: f32, channel: usize, u: f32) -> FreeFlight {
+pub fn sample_distance(m: &Medium, ray: &Ray, t_max: f32, channel: usize, u: f32) -> FreeFlight {
     let sigma = m.sigma_t.channel(channel.min(2));
     let t = if sigma > 0.0 { -(1.0 - u).ln() / sigma } else { f32::INFINITY };
     if t < t_max {
         let tr = m.transmittance(t);
-        FreeFlight { t: Some(t), value: tr * m.sigma_s, density: m.sigma_t * tr }
+        FreeFlight { t: Some(t), value: tr * m.sigma_s(ray.at(t)), density: m.sigma_t * tr }
     } else {
         let tr = m.transmittance(t_max);
         FreeFlight { t: None, value: tr, density: tr }
