@@ -70,7 +70,7 @@ fn sigma_a_and_sigma_s_become_sigma_t_and_albedo() {
 fn unsupported_media_features_are_all_reported_in_one_run_with_their_lines() {
     let e = xml(&format!(
         r#"{SENSOR}
-    <medium type="heterogeneous" id="smoke"/>
+    <medium type="smoke" id="smoke"/>
     <shape type="sphere"><ref name="interior" id="smoke"/></shape>
     <shape type="sphere"><medium type="homogeneous" name="interior"><phase type="rayleigh"/></medium></shape>
     <shape type="sphere"><medium type="homogeneous" name="interior"><rgb name="sigma_t" value="2, 1, 1"/></medium></shape>
@@ -81,7 +81,7 @@ fn unsupported_media_features_are_all_reported_in_one_run_with_their_lines() {
     let lines: Vec<&str> = e.lines().collect();
     assert_eq!(lines.len(), 5, "{e}");
     for (line, (at, what)) in lines.iter().zip([
-        ("media.xml:4:", "medium plugin 'heterogeneous' is not supported"),
+        ("media.xml:4:", "medium plugin 'smoke' is not supported"),
         ("media.xml:6:", "phase function 'rayleigh' is not supported"),
         ("media.xml:7:", "must lie in [0, 1]"),
         ("media.xml:8:", "'interior' or 'exterior'"),
@@ -289,4 +289,58 @@ fn bad_albedo_grid_files_are_one_line_errors_at_build() {
     let scene = dir.join("good.xml");
     std::fs::write(&scene, format!("<scene version=\"3.0.0\"><integrator type=\"volpath\"/>{SENSOR}<shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"homogeneous\" name=\"interior\"><volume name=\"albedo\" type=\"gridvolume\"><string name=\"filename\" value=\"good.vol\"/></volume></medium></shape></scene>")).unwrap();
     glint::build::build(&mitsuba::read(&scene, &[]).unwrap(), &Default::default()).unwrap();
+}
+
+#[test]
+fn heterogeneous_media_take_a_density_grid_as_sigma_t() {
+    let d = xml(&format!(
+        r#"{SENSOR}
+<shape type="cube"><bsdf type="null"/><medium type="heterogeneous" name="interior">
+<float name="scale" value="4"/>
+<volume name="sigma_t" type="gridvolume"><string name="filename" value="density.vol"/></volume>
+<rgb name="albedo" value="0.5"/>
+</medium></shape>"#
+    ))
+    .unwrap();
+    let m = &d.media[0];
+    assert_eq!((m.sigma_t, m.scale, m.albedo.clone()), (Rgb::WHITE, 4.0, VolumeDesc::Constant(Rgb::splat(0.5))));
+    let g = m.density.as_ref().unwrap();
+    assert!(g.file.ends_with("density.vol") && g.loc.line == 6, "{g:?}");
+    assert!(d.build_inputs().contains(&g.file));
+    // A homogeneous medium's extinction stays constant.
+    let e = xml(&medium_xml(
+        r#"<volume name="sigma_t" type="gridvolume"><string name="filename" value="d.vol"/></volume>"#,
+    ))
+    .unwrap_err();
+    assert!(e.starts_with("media.xml:5:") && e.contains("heterogeneous medium's sigma_t may be a gridvolume"), "{e}");
+}
+
+#[test]
+fn bad_density_grids_are_one_line_errors_at_build() {
+    let dir = std::env::temp_dir().join(format!("glint-media-density-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, bytes, what) in [
+        ("rgb.vol", vol_bytes([1, 1, 1], 3, &[0.5; 3]), "1 channel, not 3"),
+        ("negative.vol", vol_bytes([2, 1, 1], 1, &[0.5, -1.0]), "density -1"),
+        ("huge.vol", vol_bytes([1, 1, 1], 1, &[1e30]), "exceeds"),
+    ] {
+        std::fs::write(dir.join(name), bytes).unwrap();
+        let scene = dir.join(format!("{name}.xml"));
+        std::fs::write(
+            &scene,
+            format!(
+                "<scene version=\"3.0.0\"><integrator type=\"volpath\"/>{SENSOR}\n<shape type=\"cube\"><bsdf type=\"null\"/>\n<medium type=\"heterogeneous\" name=\"interior\">\n<volume name=\"sigma_t\" type=\"gridvolume\"><string name=\"filename\" value=\"{name}\"/></volume></medium></shape></scene>"
+            ),
+        )
+        .unwrap();
+        let e = match glint::build::build(&mitsuba::read(&scene, &[]).unwrap(), &Default::default()) {
+            Ok(_) => panic!("{name} built"),
+            Err(e) => e.to_string(),
+        };
+        let at = format!("{}:4:", scene.display());
+        assert!(
+            !e.contains('\n') && e.starts_with(&at) && e.contains(what),
+            "{name}: expected {at} ... {what}, got {e}"
+        );
+    }
 }

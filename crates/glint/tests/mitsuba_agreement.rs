@@ -217,6 +217,13 @@ fn volpath_albedo_from_grid_volumes() {
     check_media("medium-albedo-grid");
 }
 
+/// A heterogeneous medium: density from a gridvolume whose box is smaller than the null
+/// cube around it (delta tracking for distances, ratio tracking for shadow rays).
+#[test]
+fn volpath_heterogeneous_medium_from_a_density_grid() {
+    check_media("medium-heterogeneous");
+}
+
 /// The cylinder: p0/p1/radius and to_world, Mitsuba's uv, one- and two-sided, flip_normals.
 #[test]
 fn cylinder_shape() {

@@ -41,17 +41,24 @@ fn medium(m: &MediumDesc) -> Result<(), String> {
             ));
         }
     }
+    if m.density.is_some() && !(m.sigma_t.r == m.sigma_t.g && m.sigma_t.g == m.sigma_t.b) {
+        return Err("a heterogeneous medium's sigma_t must be grey".into());
+    }
+    for g in m.density.iter().chain(match &m.albedo {
+        VolumeDesc::Grid(g) => Some(g),
+        VolumeDesc::Constant(_) => None,
+    }) {
+        if Transform::from_matrix(Mat4(g.to_world)).is_none_or(|t| !t.is_finite()) {
+            return Err("a grid volume's to_world must be finite and invertible".into());
+        }
+    }
     match &m.albedo {
         VolumeDesc::Constant(a) => {
             if !a.to_array().iter().all(|a| (0.0..=1.0).contains(a)) {
                 return Err(format!("albedo ({}, {}, {}) must lie in [0, 1]", a.r, a.g, a.b));
             }
         }
-        VolumeDesc::Grid(g) => {
-            if Transform::from_matrix(Mat4(g.to_world)).is_none_or(|t| !t.is_finite()) {
-                return Err("the albedo grid's to_world must be finite and invertible".into());
-            }
-        }
+        VolumeDesc::Grid(_) => {}
     }
     if let PhaseDesc::Hg { g } = m.phase {
         if !(g > -1.0 && g < 1.0) {
@@ -77,9 +84,37 @@ pub fn media(d: &SceneDesc) -> Result<Vec<Medium>, Error> {
                     albedo_grid(g).map_err(|e| Error::at(&g.loc, format!("medium '{}': albedo: {e}", m.name)))?,
                 )),
             };
-            Ok(Medium::new(m.sigma_t * m.scale, albedo, phase, m.sample_emitters))
+            let Some(g) = &m.density else {
+                return Ok(Medium::new(m.sigma_t * m.scale, albedo, phase, m.sample_emitters));
+            };
+            let sigma_t = m.sigma_t.r * m.scale;
+            let density = density_grid(g, sigma_t)
+                .map_err(|e| Error::at(&g.loc, format!("medium '{}': sigma_t: {e}", m.name)))?;
+            Ok(Medium::heterogeneous(sigma_t, Arc::new(density), albedo, phase, m.sample_emitters))
         })
         .collect()
+}
+
+/// Reads a density grid: 1 channel, every value finite and at least 0, its largest times
+/// `sigma_t` (the majorant) at most [`MAX_EXTINCTION`].
+fn density_grid(g: &GridVolumeDesc, sigma_t: f32) -> Result<GridVolume, String> {
+    let grid = read_vol(&g.file)?;
+    let file = g.file.display();
+    if grid.channels != 1 {
+        return Err(format!("{file}: a density grid has 1 channel, not {}", grid.channels));
+    }
+    if let Some(v) = grid.data.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+        return Err(format!("{file}: density {v} must be finite and at least 0"));
+    }
+    let max = grid.data.iter().copied().fold(0.0f32, f32::max);
+    if !(max * sigma_t <= MAX_EXTINCTION) {
+        return Err(format!(
+            "{file}: the largest density {max} times sigma_t and scale ({sigma_t}) exceeds {MAX_EXTINCTION:e}"
+        ));
+    }
+    let to_world = Transform::from_matrix(Mat4(g.to_world)).ok_or("the grid's to_world is not invertible")?;
+    GridVolume::new(grid.resolution, 1, grid.data, g.filter, g.wrap, to_world)
+        .ok_or_else(|| format!("{file}: the grid's size does not match its resolution"))
 }
 
 /// Reads an albedo grid: 1 or 3 channels, every value in [0, 1].

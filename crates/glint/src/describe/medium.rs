@@ -25,6 +25,10 @@ pub struct MediumDesc {
     /// medium inside glass).
     #[serde(default = "yes")]
     pub sample_emitters: bool,
+    /// Mitsuba's `heterogeneous` with a `gridvolume` `sigma_t`: a grey density grid (1
+    /// channel) that multiplies `sigma_t` (then grey) point by point; `None` is homogeneous.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<GridVolumeDesc>,
     #[serde(default)]
     pub loc: SourceLoc,
 }

@@ -505,6 +505,9 @@ impl SceneDesc {
             if let VolumeDesc::Grid(g) = &m.albedo {
                 add(&g.file);
             }
+            if let Some(g) = &m.density {
+                add(&g.file);
+            }
         }
         out
     }
@@ -538,6 +541,9 @@ impl SceneDesc {
         }
         for m in &mut self.media {
             if let VolumeDesc::Grid(g) = &mut m.albedo {
+                map(&mut g.file)?;
+            }
+            if let Some(g) = &mut m.density {
                 map(&mut g.file)?;
             }
         }

@@ -1063,6 +1063,7 @@ fn medium_of(ctx: &Ctx, name: &str, m: &JsonMedium) -> Result<MediumDesc, Error>
         scale: m.scale.unwrap_or(1.0),
         phase: m.phase.unwrap_or_default(),
         sample_emitters: m.sample_emitters.unwrap_or(true),
+        density: None,
         loc: ctx.loc(&at),
     })
 }

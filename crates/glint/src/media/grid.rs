@@ -49,6 +49,12 @@ impl GridVolume {
         self.data.iter().copied().fold(f32::NEG_INFINITY, f32::max)
     }
 
+    /// Whether world point `p` lies in the grid's box (the unit cube placed by `to_world`).
+    pub fn contains(&self, p: Vec3) -> bool {
+        let l = self.to_world.inv_point(p);
+        [l.x, l.y, l.z].iter().all(|v| (0.0..=1.0).contains(v))
+    }
+
     /// The value at world point `p` (grey grids in all three channels).
     pub fn eval(&self, p: Vec3) -> Rgb {
         let local = self.to_world.inv_point(p);

@@ -1,9 +1,9 @@
 //! Mitsuba's participating media: `<medium type="homogeneous">` with its `<phase>`
 //! (`isotropic`, `hg`), attached to shapes as `interior`/`exterior` (nested or by
 //! `<ref name=... id=...>`) and to the sensor. The albedo may be a `gridvolume` (a `.vol`
-//! file, looked up at each scattering point) and any coefficient a `constvolume`.
-//! Heterogeneous media, grid extinction and other phase functions are errors that name the
-//! file and line.
+//! file, looked up at each scattering point) and any coefficient a `constvolume`;
+//! `heterogeneous` media take a grey `gridvolume` `sigma_t` too. Grid extinction in a
+//! homogeneous medium and other phase functions are errors that name the file and line.
 
 use super::props::{color_of, Props};
 use super::spectrum::SpectrumUse;
@@ -65,18 +65,21 @@ impl<'a> Reader<'a> {
 
     fn medium_desc(&mut self, el: &'a Element) -> Result<MediumDesc, Error> {
         let ty = el.attr("type").unwrap_or("");
-        if ty != "homogeneous" {
-            return Err(el.err(format!("medium plugin '{ty}' is not supported (homogeneous)")));
+        if !matches!(ty, "homogeneous" | "heterogeneous") {
+            return Err(el.err(format!("medium plugin '{ty}' is not supported (homogeneous, heterogeneous)")));
         }
+        let heterogeneous = ty == "heterogeneous";
         let p = Props::new(el);
         // Volumes: a constant anywhere, a grid only for the albedo (the extinction of a
         // homogeneous medium is constant).
         for name in ["sigma_t", "sigma_a", "sigma_s"] {
             if let Some(e) = p.find(name) {
-                if e.tag == "volume" && e.attr("type") != Some("constvolume") {
+                let grid_extinction = heterogeneous && name == "sigma_t" && e.attr("type") == Some("gridvolume");
+                if e.tag == "volume" && e.attr("type") != Some("constvolume") && !grid_extinction {
                     return Err(e.err(format!(
                         "homogeneous: '{name}' given as a <volume type=\"{}\"> is not supported (a homogeneous medium's \
-                         extinction is constant: give a <float>, <rgb>, <spectrum> or a constvolume)",
+                         extinction is constant: give a <float>, <rgb>, <spectrum> or a constvolume; a heterogeneous \
+                         medium's sigma_t may be a gridvolume)",
                         e.attr("type").unwrap_or("")
                     )));
                 }
@@ -119,7 +122,15 @@ impl<'a> Reader<'a> {
                 }
                 _ => VolumeDesc::Constant(coefficient("albedo", 0.75)?),
             };
-            (coefficient("sigma_t", 1.0)?, albedo)
+            let sigma_t = match p.find("sigma_t") {
+                Some(e) if e.tag == "volume" && e.attr("type") == Some("gridvolume") => Rgb::WHITE,
+                _ => coefficient("sigma_t", 1.0)?,
+            };
+            (sigma_t, albedo)
+        };
+        let density = match p.find("sigma_t") {
+            Some(e) if e.tag == "volume" && e.attr("type") == Some("gridvolume") => Some(self.grid_volume(e)?),
+            _ => None,
         };
         let scale = p.float("scale", 1.0)?;
         let spectral = p.bool("has_spectral_extinction", true)?;
@@ -150,7 +161,7 @@ impl<'a> Reader<'a> {
         }
         self.warn_unused(&p);
         let name = el.attr("id").map_or_else(|| format!("medium@{}:{}", el.file.display(), el.line), str::to_string);
-        Ok(MediumDesc { name, sigma_t, albedo, scale, phase, sample_emitters, loc: el.loc() })
+        Ok(MediumDesc { name, sigma_t, albedo, scale, phase, sample_emitters, density, loc: el.loc() })
     }
 
     /// A `constvolume`'s value (its `value`, a colour; 1 by default).
@@ -185,7 +196,8 @@ impl<'a> Reader<'a> {
         Ok(value)
     }
 
-    /// A `gridvolume`: its file, filter, wrap mode and placement.
+    /// A `gridvolume`: its file, filter, wrap mode and placement (an albedo, or a
+    /// heterogeneous medium's density).
     fn grid_volume(&self, el: &'a Element) -> Result<GridVolumeDesc, Error> {
         let p = Props::new(el);
         let file = p.string("filename").ok_or_else(|| el.err("gridvolume needs 'filename' (a .vol file)"))?;
