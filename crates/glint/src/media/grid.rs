@@ -234,7 +234,7 @@ mod tests {
                 .unwrap();
         // Repeated, x = 0 lies midway between the last cell's centre (-0.25) and the first's.
         assert!((repeat.eval(vec3(0.0, 0.5, 0.5)).r - 0.5).abs() < 1e-6);
-        assert_eq!(g.eval(vec3(f32::NAN, f32::INFINITY, -f32::INFINITY)).r.is_finite(), true);
+        assert!(g.eval(vec3(f32::NAN, f32::INFINITY, -f32::INFINITY)).r.is_finite());
     }
 
     #[test]
