@@ -11,7 +11,7 @@
 //! are not clamped.
 
 use crate::describe::{GridFilter, GridWrap};
-use crate::math::{Rgb, Transform, Vec3};
+use crate::math::{Ray, Rgb, Transform, Vec3};
 
 /// A grid of 1 or 3 channels placed by `to_world` (the unit cube's transform).
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +53,27 @@ impl GridVolume {
     pub fn contains(&self, p: Vec3) -> bool {
         let l = self.to_world.inv_point(p);
         [l.x, l.y, l.z].iter().all(|v| (0.0..=1.0).contains(v))
+    }
+
+    /// The part [t0, t1] of `ray` within [0, t_max] that lies in the grid's box, `None` when
+    /// the ray misses it there.
+    pub fn clip(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32)> {
+        let o = self.to_world.inv_point(ray.origin);
+        let d = self.to_world.inv_vector(ray.dir);
+        let (mut t0, mut t1) = (0.0f32, t_max);
+        for (o, d) in [(o.x, d.x), (o.y, d.y), (o.z, d.z)] {
+            if d == 0.0 || !d.is_finite() {
+                if !(0.0..=1.0).contains(&o) {
+                    return None;
+                }
+                continue;
+            }
+            let (a, b) = ((0.0 - o) / d, (1.0 - o) / d);
+            let (near, far) = if a <= b { (a, b) } else { (b, a) };
+            t0 = t0.max(near);
+            t1 = t1.min(far);
+        }
+        (t0 <= t1).then_some((t0, t1))
     }
 
     /// The value at world point `p` (grey grids in all three channels).
@@ -258,6 +279,21 @@ mod tests {
             assert_eq!(clamp.eval(vec3(x, 0.5, 0.5)).r, c, "clamp at {x}");
             assert_eq!(repeat.eval(vec3(x, 0.5, 0.5)).r, r, "repeat at {x}");
         }
+    }
+
+    #[test]
+    fn rays_are_clipped_to_the_grid_box() {
+        let g = grid(GridFilter::Trilinear, GridWrap::Clamp); // box [0.1, 2.1] x [0, 1] x [0, 1]
+        let r = Ray::new(vec3(-0.9, 0.5, 0.5), vec3(1.0, 0.0, 0.0));
+        let (t0, t1) = g.clip(&r, 100.0).unwrap();
+        assert!((t0 - 1.0).abs() < 1e-5 && (t1 - 3.0).abs() < 1e-5, "{t0} {t1}");
+        assert_eq!(g.clip(&r, 0.5), None);
+        let (t0, t1) = g.clip(&r, 2.0).unwrap();
+        assert!((t0 - 1.0).abs() < 1e-5 && t1 == 2.0);
+        assert_eq!(g.clip(&Ray::new(vec3(-0.9, 1.5, 0.5), vec3(1.0, 0.0, 0.0)), 100.0), None);
+        let inside = Ray::new(vec3(1.0, 0.5, 0.5), vec3(0.0, 0.0, -1.0));
+        let (t0, t1) = g.clip(&inside, f32::INFINITY).unwrap();
+        assert!(t0 == 0.0 && (t1 - 0.5).abs() < 1e-6);
     }
 
     #[test]

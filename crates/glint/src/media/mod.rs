@@ -114,11 +114,13 @@ impl Medium {
         if !(d.majorant > 0.0) {
             return Rgb::WHITE;
         }
+        // Only the part of the ray inside the grid's box has any extinction.
+        let Some((t0, t1)) = d.grid.clip(ray, t) else { return Rgb::WHITE };
         let mut tr = 1.0f32;
-        let mut s = 0.0f32;
+        let mut s = t0;
         for _ in 0..MAX_TRACKING_STEPS {
             let next = s - (1.0 - rng.next_f32()).ln() / d.majorant;
-            if !(next < t) || next <= s {
+            if !(next < t1) || next <= s {
                 break;
             }
             s = next;
@@ -223,10 +225,11 @@ fn delta_tracking(m: &Medium, d: &Density, ray: &Ray, t_max: f32, rng: &mut Samp
     if !(d.majorant > 0.0) {
         return passed;
     }
-    let mut s = 0.0f32;
+    let Some((t0, t1)) = d.grid.clip(ray, t_max) else { return passed };
+    let mut s = t0;
     for _ in 0..MAX_TRACKING_STEPS {
         let next = s - (1.0 - rng.next_f32()).ln() / d.majorant;
-        if !(next < t_max) || next <= s {
+        if !(next < t1) || next <= s {
             return passed;
         }
         s = next;
