@@ -299,3 +299,43 @@ fn whitted_in_glass_does_not_double_its_work_forever() {
     let o = run(&["render", &f, "-o", &d.out(), "--spp", "1", "--width", "4", "--height", "4", "--quiet"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+#[test]
+fn bad_volume_grids_are_one_line_errors() {
+    let d = Dir::new("vol");
+    let header = |res: [i32; 3], channels: i32| {
+        let mut b = b"VOL\x03".to_vec();
+        for v in [1, res[0], res[1], res[2], channels] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.extend_from_slice(&[0u8; 24]);
+        b
+    };
+    let mut nan = header([1, 1, 1], 1);
+    nan.extend_from_slice(&f32::NAN.to_le_bytes());
+    for (vol, bytes, needle) in [
+        // Claims 2^31 cells per axis: refused from the header, nothing allocated.
+        ("huge.vol", header([i32::MAX, i32::MAX, i32::MAX], 3), "truncated volume grid"),
+        ("short.vol", b"VOL\x03\x01\x00".to_vec(), "truncated volume grid header"),
+        ("v2.vol", b"VOL\x02".to_vec(), "version 2"),
+        ("nan.vol", nan, "must lie in [0, 1]"),
+    ] {
+        std::fs::write(d.0.join(vol), bytes).unwrap();
+        let f = d.write(
+            &format!("{vol}.xml"),
+            &xml(&format!(
+                r#"<integrator type="volpath"/><shape type="sphere"><bsdf type="null"/>
+<medium type="homogeneous" name="interior"><volume name="albedo" type="gridvolume"><string name="filename" value="{vol}"/></volume></medium></shape>"#
+            )),
+        );
+        rejects(&d, &f, needle, &[]);
+    }
+    // An unknown wrap mode is named at its line.
+    let f = d.write(
+        "wrap.xml",
+        &xml(r#"<integrator type="volpath"/><shape type="sphere"><bsdf type="null"/>
+<medium type="homogeneous" name="interior"><volume name="albedo" type="gridvolume"><string name="filename" value="a.vol"/>
+<string name="wrap_mode" value="wobble"/></volume></medium></shape>"#),
+    );
+    rejects(&d, &f, "wrap.xml:7:", &[]);
+}

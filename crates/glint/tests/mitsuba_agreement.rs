@@ -210,6 +210,20 @@ fn volpath_camera_in_fog_with_rgb_extinction() {
     check_media("medium-rgb");
 }
 
+/// Albedo from gridvolumes: trilinear/repeat RGB grid rotated by its to_world inside glass
+/// without emitter sampling, and a nearest/mirror grey grid in a null-bounded cube.
+#[test]
+fn volpath_albedo_from_grid_volumes() {
+    check_media("medium-albedo-grid");
+}
+
+/// A heterogeneous medium: density from a gridvolume whose box is smaller than the null
+/// cube around it (delta tracking for distances, ratio tracking for shadow rays).
+#[test]
+fn volpath_heterogeneous_medium_from_a_density_grid() {
+    check_media("medium-heterogeneous");
+}
+
 /// The cylinder: p0/p1/radius and to_world, Mitsuba's uv, one- and two-sided, flip_normals.
 #[test]
 fn cylinder_shape() {

@@ -446,7 +446,7 @@ fn every_unsupported_feature_is_reported() {
 <shape type="linearcurve"/>
 <shape type="sphere">
   <bsdf type="velvet"/>
-  <medium type="heterogeneous" name="interior"/>
+  <medium type="heterogeneous" name="interior"><phase type="rayleigh"/></medium>
 </shape>
 <emitter type="sunsky"/>
 <phase type="hg" id="p"/>
@@ -463,7 +463,7 @@ fn every_unsupported_feature_is_reported() {
     let expect = [
         (4, "linearcurve"),
         (6, "velvet"),
-        (7, "heterogeneous"),
+        (7, "rayleigh"),
         (9, "sunsky"),
         (10, "phase"),
         (11, "'interior' or 'exterior'"),

@@ -121,7 +121,7 @@ pub fn build_cached(
         material_ids.push(b.add_material(Material::new(m.name.clone(), kind, m.two_sided)));
     }
     load_files(desc, opts.bvh_split, cache, &mut b)?;
-    for m in super::media::media(desc) {
+    for m in super::media::media(desc)? {
         b.add_medium(m);
     }
     b.set_camera_medium(desc.camera.medium.map(|i| i as u32));
@@ -406,7 +406,7 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
     world.lights.extend(lights);
     world.environment_lights = environment_lights(&world.lights);
     world.camera = camera;
-    world.media = super::media::media(desc);
+    world.media = super::media::media(desc)?;
     world.camera_medium = desc.camera.medium.map(|i| i as u32);
     for (s, instances) in desc.shapes.iter().zip(&layout.shape_instances) {
         for i in instances.clone() {

@@ -1,18 +1,21 @@
 //! Participating media as a scene describes them, and the settings of the volumetric path
 //! tracer that renders them (the media themselves live in `media`).
 
+use super::Matrix4;
 use crate::error::SourceLoc;
 use crate::math::Rgb;
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// A homogeneous medium (Mitsuba's `homogeneous`): extinction `sigma_t * scale` per unit
-/// length in every channel, and the single-scattering albedo (scattering over extinction).
+/// length in every channel, and the single-scattering albedo (scattering over extinction),
+/// constant or looked up in a grid volume at each scattering point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MediumDesc {
     pub name: String,
     pub sigma_t: Rgb,
-    pub albedo: Rgb,
+    pub albedo: VolumeDesc,
     #[serde(default = "one")]
     pub scale: f32,
     #[serde(default)]
@@ -22,8 +25,83 @@ pub struct MediumDesc {
     /// medium inside glass).
     #[serde(default = "yes")]
     pub sample_emitters: bool,
+    /// Mitsuba's `heterogeneous` with a `gridvolume` `sigma_t`: a grey density grid (1
+    /// channel) that multiplies `sigma_t` (then grey) point by point; `None` is homogeneous.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<GridVolumeDesc>,
     #[serde(default)]
     pub loc: SourceLoc,
+}
+
+/// A quantity that may vary through space (Mitsuba's `<volume>`): a constant (a colour, or
+/// a `constvolume`) or a grid of values read from a `.vol` file (`gridvolume`). A constant
+/// is written as its colour alone.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum VolumeDesc {
+    Constant(Rgb),
+    Grid(GridVolumeDesc),
+}
+
+impl VolumeDesc {
+    /// The constant value, `None` for a grid.
+    pub fn constant(&self) -> Option<Rgb> {
+        match self {
+            VolumeDesc::Constant(c) => Some(*c),
+            VolumeDesc::Grid(_) => None,
+        }
+    }
+}
+
+impl From<Rgb> for VolumeDesc {
+    fn from(c: Rgb) -> Self {
+        VolumeDesc::Constant(c)
+    }
+}
+
+/// Mitsuba's `gridvolume`: the values of a `.vol` file (1 or 3 channels) on the unit cube,
+/// placed in the world by `to_world` (the file's own bounding box is not used, as in
+/// Mitsuba 3). Cell (i, j, k) holds the value at the cell's centre ((i + 0.5) / res_x, ...).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridVolumeDesc {
+    pub file: PathBuf,
+    #[serde(default)]
+    pub filter: GridFilter,
+    #[serde(default)]
+    pub wrap: GridWrap,
+    #[serde(default = "identity")]
+    pub to_world: Matrix4,
+    #[serde(default)]
+    pub loc: SourceLoc,
+}
+
+fn identity() -> Matrix4 {
+    super::IDENTITY
+}
+
+/// How a grid volume is interpolated between cell centres.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GridFilter {
+    /// Trilinear interpolation between the 8 nearest cell centres.
+    #[default]
+    Trilinear,
+    /// The value of the cell the point lies in.
+    Nearest,
+}
+
+/// What a grid volume holds outside the unit cube.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GridWrap {
+    /// The edge cells extend outwards (Mitsuba's default).
+    #[default]
+    Clamp,
+    /// The grid tiles space.
+    Repeat,
+    /// The grid tiles space, every other copy mirrored.
+    Mirror,
 }
 
 fn one() -> f32 {

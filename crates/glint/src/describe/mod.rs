@@ -22,7 +22,7 @@ pub mod limits;
 mod medium;
 mod principled_blend;
 pub use integrator::{DirectSettings, PathSettings, Strategy, WhittedSettings};
-pub use medium::{MediumDesc, PhaseDesc, VolpathSettings};
+pub use medium::{GridFilter, GridVolumeDesc, GridWrap, MediumDesc, PhaseDesc, VolpathSettings, VolumeDesc};
 pub use principled_blend::{BlendDesc, BlendPartDesc, PrincipledDesc};
 
 /// A 4x4 row-major object-to-world matrix (column vectors: `p' = M p`).
@@ -535,6 +535,14 @@ impl SceneDesc {
                 _ => {}
             }
         }
+        for m in &self.media {
+            if let VolumeDesc::Grid(g) = &m.albedo {
+                add(&g.file);
+            }
+            if let Some(g) = &m.density {
+                add(&g.file);
+            }
+        }
         out
     }
 
@@ -563,6 +571,14 @@ impl SceneDesc {
         for l in &mut self.lights {
             if let LightKind::EnvMap { file, .. } = &mut l.light {
                 map(file)?;
+            }
+        }
+        for m in &mut self.media {
+            if let VolumeDesc::Grid(g) = &mut m.albedo {
+                map(&mut g.file)?;
+            }
+            if let Some(g) = &mut m.density {
+                map(&mut g.file)?;
             }
         }
         Ok(())

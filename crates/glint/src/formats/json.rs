@@ -1062,10 +1062,11 @@ fn medium_of(ctx: &Ctx, name: &str, m: &JsonMedium) -> Result<MediumDesc, Error>
     Ok(MediumDesc {
         name: name.to_string(),
         sigma_t: m.sigma_t.map_or(Rgb::WHITE, |c| c.rgb()),
-        albedo: m.albedo.map_or(Rgb::splat(0.75), |c| c.rgb()),
+        albedo: m.albedo.map_or(Rgb::splat(0.75), |c| c.rgb()).into(),
         scale: m.scale.unwrap_or(1.0),
         phase: m.phase.unwrap_or_default(),
         sample_emitters: m.sample_emitters.unwrap_or(true),
+        density: None,
         loc: ctx.loc(&at),
     })
 }

@@ -15,8 +15,10 @@
 //!
 //! Depth counts scattering events (in media and at surfaces, not passages), as Mitsuba's
 //! `max_depth` does: 1 shows emitters seen directly (through any passages and media), 2
-//! adds single scattering, and so on. Transmittance along shadow rays is exact (homogeneous
-//! media): exp(-σt d) per channel and per medium crossed.
+//! adds single scattering, and so on. Transmittance along shadow rays is exact in homogeneous
+//! media (exp(-σt d) per channel and per medium crossed); heterogeneous media (grey
+//! extinction from a density grid) sample distances by delta tracking and estimate shadow
+//! rays' transmittance by ratio tracking, both against the grid's majorant.
 
 use super::path::MAX_PATH_DEPTH;
 use super::{shading, shadow_ray, spawn_ray, Counters};
@@ -67,7 +69,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
         if let Some(mi) = medium {
             let m = &scene.media[mi as usize];
             let t_max = hit.map_or(f32::INFINITY, |h| h.t);
-            let flight = sample_distance(m, t_max, channel, rng.next_f32());
+            let flight = sample_distance(m, &ray, t_max, channel, rng);
             let mean = (density_ratio * flight.density).average();
             if !(mean > 0.0) {
                 break;
@@ -150,7 +152,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
                 let f = bsdf.eval(wo, wi);
                 if !f.is_black() {
                     let start = boundary.medium_after(ls.wi.dot(si.ng), medium);
-                    let tr = transmittance(scene, shadow_ray(&si, ls.wi, ls.dist), start, passable, c);
+                    let tr = transmittance(scene, shadow_ray(&si, ls.wi, ls.dist), start, passable, rng, c);
                     if !tr.is_black() {
                         let light_pdf = pick_pmf * ls.pdf;
                         let w = if ls.delta { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
@@ -242,7 +244,7 @@ fn light_at_medium_point(
         return Rgb::BLACK;
     }
     let ray = if ls.dist.is_finite() { Ray::segment(p, ls.wi, ls.dist * (1.0 - 1e-4)) } else { Ray::new(p, ls.wi) };
-    let tr = transmittance(scene, ray, medium, passable, c);
+    let tr = transmittance(scene, ray, medium, passable, rng, c);
     if tr.is_black() {
         return Rgb::BLACK;
     }
@@ -254,7 +256,14 @@ fn light_at_medium_point(
 /// The fraction of light that travels along the shadow ray `ray`, which starts in `medium`:
 /// zero when a surface that is not a passage blocks it, else the product of the media's
 /// transmittances and the passages' transmission.
-fn transmittance(scene: &World, mut ray: Ray, mut medium: Option<u32>, passable: bool, c: &mut Counters) -> Rgb {
+fn transmittance(
+    scene: &World,
+    mut ray: Ray,
+    mut medium: Option<u32>,
+    passable: bool,
+    rng: &mut Sampler,
+    c: &mut Counters,
+) -> Rgb {
     c.shadow_rays += 1;
     if !passable {
         return if scene.occluded(&ray) { Rgb::BLACK } else { Rgb::WHITE };
@@ -263,7 +272,7 @@ fn transmittance(scene: &World, mut ray: Ray, mut medium: Option<u32>, passable:
     for _ in 0..=MAX_PASSAGES {
         let hit = scene.intersect(&ray);
         if let Some(m) = medium {
-            tr *= scene.media[m as usize].transmittance(hit.map_or(ray.t_max, |h| h.t));
+            tr *= scene.media[m as usize].transmittance_along(&ray, hit.map_or(ray.t_max, |h| h.t), rng);
         }
         let Some(hit) = hit else {
             return tr;

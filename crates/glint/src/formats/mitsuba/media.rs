@@ -1,13 +1,15 @@
 //! Mitsuba's participating media: `<medium type="homogeneous">` with its `<phase>`
 //! (`isotropic`, `hg`), attached to shapes as `interior`/`exterior` (nested or by
-//! `<ref name=... id=...>`) and to the sensor. Heterogeneous media, grid volumes and other
-//! phase functions are errors that name the file and line.
+//! `<ref name=... id=...>`) and to the sensor. The albedo may be a `gridvolume` (a `.vol`
+//! file, looked up at each scattering point) and any coefficient a `constvolume`;
+//! `heterogeneous` media take a grey `gridvolume` `sigma_t` too. Grid extinction in a
+//! homogeneous medium and other phase functions are errors that name the file and line.
 
 use super::props::{color_of, Props};
 use super::spectrum::SpectrumUse;
 use super::xml::Element;
 use super::Reader;
-use crate::describe::{MediumDesc, PhaseDesc, ShapeMedia};
+use crate::describe::{GridFilter, GridVolumeDesc, GridWrap, MediumDesc, PhaseDesc, ShapeMedia, VolumeDesc};
 use crate::error::Error;
 use crate::math::Rgb;
 
@@ -63,15 +65,21 @@ impl<'a> Reader<'a> {
 
     fn medium_desc(&mut self, el: &'a Element) -> Result<MediumDesc, Error> {
         let ty = el.attr("type").unwrap_or("");
-        if ty != "homogeneous" {
-            return Err(el.err(format!("medium plugin '{ty}' is not supported (homogeneous)")));
+        if !matches!(ty, "homogeneous" | "heterogeneous") {
+            return Err(el.err(format!("medium plugin '{ty}' is not supported (homogeneous, heterogeneous)")));
         }
+        let heterogeneous = ty == "heterogeneous";
         let p = Props::new(el);
-        for name in ["sigma_t", "albedo", "sigma_a", "sigma_s"] {
+        // Volumes: a constant anywhere, a grid only for the albedo (the extinction of a
+        // homogeneous medium is constant).
+        for name in ["sigma_t", "sigma_a", "sigma_s"] {
             if let Some(e) = p.find(name) {
-                if e.tag == "volume" {
+                let grid_extinction = heterogeneous && name == "sigma_t" && e.attr("type") == Some("gridvolume");
+                if e.tag == "volume" && e.attr("type") != Some("constvolume") && !grid_extinction {
                     return Err(e.err(format!(
-                        "homogeneous: '{name}' given as a <volume type=\"{}\"> is not supported (give a <float>, <rgb> or <spectrum>)",
+                        "homogeneous: '{name}' given as a <volume type=\"{}\"> is not supported (a homogeneous medium's \
+                         extinction is constant: give a <float>, <rgb>, <spectrum> or a constvolume; a heterogeneous \
+                         medium's sigma_t may be a gridvolume)",
                         e.attr("type").unwrap_or("")
                     )));
                 }
@@ -82,6 +90,9 @@ impl<'a> Reader<'a> {
                 None => Ok(Rgb::splat(default)),
                 Some(e) => {
                     let e = self.resolve(e)?;
+                    if e.tag == "volume" {
+                        return self.const_volume(e);
+                    }
                     let v = color_of(e, SpectrumUse::Reflectance)?;
                     // Mitsuba reads these as reflectance-like textures, which reject RGB
                     // values outside [0, 1] (its documentation: use `scale` for more).
@@ -103,9 +114,23 @@ impl<'a> Reader<'a> {
             let (a, s) = (coefficient("sigma_a", 0.0)?, coefficient("sigma_s", 0.0)?);
             let t = a + s;
             let albedo = Rgb { r: ratio(s.r, t.r), g: ratio(s.g, t.g), b: ratio(s.b, t.b) };
-            (t, albedo)
+            (t, VolumeDesc::Constant(albedo))
         } else {
-            (coefficient("sigma_t", 1.0)?, coefficient("albedo", 0.75)?)
+            let albedo = match p.find("albedo") {
+                Some(e) if e.tag == "volume" && e.attr("type") == Some("gridvolume") => {
+                    VolumeDesc::Grid(self.grid_volume(e)?)
+                }
+                _ => VolumeDesc::Constant(coefficient("albedo", 0.75)?),
+            };
+            let sigma_t = match p.find("sigma_t") {
+                Some(e) if e.tag == "volume" && e.attr("type") == Some("gridvolume") => Rgb::WHITE,
+                _ => coefficient("sigma_t", 1.0)?,
+            };
+            (sigma_t, albedo)
+        };
+        let density = match p.find("sigma_t") {
+            Some(e) if e.tag == "volume" && e.attr("type") == Some("gridvolume") => Some(self.grid_volume(e)?),
+            _ => None,
         };
         let scale = p.float("scale", 1.0)?;
         let spectral = p.bool("has_spectral_extinction", true)?;
@@ -131,12 +156,98 @@ impl<'a> Reader<'a> {
                 }
                 phase = self.phase(target)?;
             } else if target.tag == "volume" && c.attr("name").is_none() {
-                return Err(c.err("homogeneous: a <volume> needs a name (and grid volumes are not supported)"));
+                return Err(c.err("homogeneous: a <volume> needs a name (sigma_t or albedo)"));
             }
         }
         self.warn_unused(&p);
         let name = el.attr("id").map_or_else(|| format!("medium@{}:{}", el.file.display(), el.line), str::to_string);
-        Ok(MediumDesc { name, sigma_t, albedo, scale, phase, sample_emitters, loc: el.loc() })
+        Ok(MediumDesc { name, sigma_t, albedo, scale, phase, sample_emitters, density, loc: el.loc() })
+    }
+
+    /// A `constvolume`'s value (its `value`, a colour; 1 by default).
+    fn const_volume(&self, el: &'a Element) -> Result<Rgb, Error> {
+        match el.attr("type").unwrap_or("") {
+            "constvolume" => {}
+            other => {
+                return Err(el.err(format!(
+                    "volume plugin '{other}' is not supported here (constvolume; gridvolume for an albedo)"
+                )));
+            }
+        }
+        let mut value = Rgb::WHITE;
+        for c in &el.children {
+            match (c.attr("name"), c.tag.as_str()) {
+                (Some("value"), "float" | "rgb" | "spectrum") => value = color_of(c, SpectrumUse::Reflectance)?,
+                (Some("value"), tag) => {
+                    return Err(
+                        c.err(format!("constvolume: 'value' should be a <float>, <rgb> or <spectrum>, found <{tag}>"))
+                    )
+                }
+                // Mitsuba's constvolume accepts a to_world, which a constant ignores.
+                (Some("to_world"), "transform") => {}
+                (name, _) => {
+                    return Err(c.err(format!(
+                        "constvolume: parameter '{}' is not supported (value, to_world)",
+                        name.unwrap_or(&c.tag)
+                    )))
+                }
+            }
+        }
+        Ok(value)
+    }
+
+    /// A `gridvolume`: its file, filter, wrap mode and placement (an albedo, or a
+    /// heterogeneous medium's density).
+    fn grid_volume(&self, el: &'a Element) -> Result<GridVolumeDesc, Error> {
+        let p = Props::new(el);
+        let file = p.string("filename").ok_or_else(|| el.err("gridvolume needs 'filename' (a .vol file)"))?;
+        let filter = match p.string("filter_type").unwrap_or("trilinear") {
+            "trilinear" => GridFilter::Trilinear,
+            "nearest" => GridFilter::Nearest,
+            other => {
+                let e = p.find("filter_type").unwrap_or(el);
+                return Err(e.err(format!("gridvolume: filter_type '{other}' is not one of trilinear, nearest")));
+            }
+        };
+        let wrap = match p.string("wrap_mode").unwrap_or("clamp") {
+            "clamp" => GridWrap::Clamp,
+            "repeat" => GridWrap::Repeat,
+            "mirror" => GridWrap::Mirror,
+            other => {
+                let e = p.find("wrap_mode").unwrap_or(el);
+                return Err(e.err(format!("gridvolume: wrap_mode '{other}' is not one of clamp, repeat, mirror")));
+            }
+        };
+        let to_world = p.transform("to_world")?;
+        // `raw` only changes spectral variants (no spectral upsampling); `accel` and
+        // `max_value` change nothing an albedo lookup sees.
+        let _ = p.bool("raw", false)?;
+        let _ = p.bool("accel", true)?;
+        let _ = p.float("max_value", 0.0)?;
+        if p.bool("use_grid_bbox", false)? {
+            let e = p.find("use_grid_bbox").unwrap_or(el);
+            return Err(e.err("gridvolume: use_grid_bbox=true is not supported (place the grid with to_world)"));
+        }
+        for c in &el.children {
+            if let Some(name) = c.attr("name") {
+                if !matches!(
+                    name,
+                    "filename"
+                        | "filter_type"
+                        | "wrap_mode"
+                        | "to_world"
+                        | "raw"
+                        | "accel"
+                        | "max_value"
+                        | "use_grid_bbox"
+                ) {
+                    return Err(c.err(format!(
+                        "gridvolume: parameter '{name}' is not supported (filename, filter_type, wrap_mode, to_world, raw)"
+                    )));
+                }
+            }
+        }
+        Ok(GridVolumeDesc { file: self.resolve_file(el, file), filter, wrap, to_world: to_world.m.0, loc: el.loc() })
     }
 
     fn phase(&mut self, el: &'a Element) -> Result<PhaseDesc, Error> {
