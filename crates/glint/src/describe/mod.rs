@@ -526,6 +526,9 @@ impl SceneDesc {
             if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } = &s.geometry {
                 add(file);
             }
+            if let Some(Emission { radiance: TextureDesc::Bitmap { file, .. }, .. }) = &s.emission {
+                add(file);
+            }
         }
         for l in &self.lights {
             match &l.light {
@@ -567,10 +570,16 @@ impl SceneDesc {
             if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } = &mut s.geometry {
                 map(file)?;
             }
+            if let Some(Emission { radiance: TextureDesc::Bitmap { file, .. }, .. }) = &mut s.emission {
+                map(file)?;
+            }
         }
         for l in &mut self.lights {
-            if let LightKind::EnvMap { file, .. } = &mut l.light {
-                map(file)?;
+            match &mut l.light {
+                LightKind::EnvMap { file, .. }
+                | LightKind::TexturedSpot { texture: TextureDesc::Bitmap { file, .. }, .. }
+                | LightKind::Projector { irradiance: TextureDesc::Bitmap { file, .. }, .. } => map(file)?,
+                _ => {}
             }
         }
         for m in &mut self.media {
@@ -757,13 +766,47 @@ mod tests {
             light: LightKind::EnvMap { file: "sky.exr".into(), scale: 1.0, to_world: IDENTITY },
             loc: SourceLoc::default(),
         });
+        d.shapes.push(ShapeDesc {
+            geometry: Geometry::Sphere { center: Vec3::ZERO, radius: 1.0 },
+            to_world: IDENTITY,
+            material: MaterialRef::DefaultDiffuse,
+            use_mtl: false,
+            emission: Some(Emission { radiance: bitmap("glow.png"), two_sided: false }),
+            flip_normals: false,
+            loc: SourceLoc::default(),
+            media: ShapeMedia::default(),
+        });
+        d.lights.push(LightDesc {
+            light: LightKind::TexturedSpot {
+                to_world: IDENTITY,
+                intensity: Rgb::WHITE,
+                cutoff_degrees: 20.0,
+                beam_degrees: 15.0,
+                texture: bitmap("slide.png"),
+            },
+            loc: SourceLoc::default(),
+        });
+        d.lights.push(LightDesc {
+            light: LightKind::Projector {
+                to_world: IDENTITY,
+                irradiance: bitmap("beamer.png"),
+                scale: 1.0,
+                fov_degrees: 30.0,
+                fov_axis: FovAxis::X,
+            },
+            loc: SourceLoc::default(),
+        });
         d
     }
 
     #[test]
     fn build_inputs_are_the_files_less_the_scene_text_and_map_in_place() {
         let mut d = desc_with_files();
-        let inputs: Vec<PathBuf> = ["wood.png", "bunny.ply", "box.obj", "sky.exr"].iter().map(PathBuf::from).collect();
+        let inputs: Vec<PathBuf> =
+            ["wood.png", "bunny.ply", "box.obj", "glow.png", "sky.exr", "slide.png", "beamer.png"]
+                .iter()
+                .map(PathBuf::from)
+                .collect();
         assert_eq!(d.build_inputs(), inputs);
         let mut files = vec![PathBuf::from("scene.xml"), "part.xml".into()];
         files.extend(inputs.clone());
@@ -775,7 +818,14 @@ mod tests {
             Ok::<_, ()>(Path::new("copies").join(p))
         })
         .unwrap();
-        assert_eq!(seen.len(), 5);
+        assert_eq!(seen.len(), inputs.len() + 1);
+        let mut unique: Vec<PathBuf> = Vec::new();
+        for p in seen {
+            if !unique.contains(&p) {
+                unique.push(p);
+            }
+        }
+        assert_eq!(unique, inputs, "map_build_inputs and build_inputs visit different files");
         assert_eq!(d.build_inputs(), inputs.iter().map(|p| Path::new("copies").join(p)).collect::<Vec<_>>());
         assert_eq!(d.source, Some("scene.xml".into()));
         assert_eq!(d.map_build_inputs(&mut |_| Err("refused")), Err("refused"));
