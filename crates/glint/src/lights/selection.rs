@@ -9,7 +9,8 @@ pub enum LightSelection {
     /// Proportional to area (the paper's choice); non-area lights get the mean weight.
     Area,
     /// Proportional to emitted power among bounded lights; each infinite light (sky,
-    /// environment map, directional) is chosen as often as all bounded lights together.
+    /// environment map, directional) is chosen as often as all bounded lights together; half
+    /// of the choices are made so, the other half uniformly (see `World::POWER_SHARE`).
     #[default]
     Power,
 }
