@@ -18,8 +18,11 @@ const MIN_SOLID_ANGLE: f64 = 1e-4;
 const MAX_SOLID_ANGLE: f64 = 6.2;
 /// Area sampling's density in solid angle, d³/h (h: the point's height over the light's
 /// plane), varies across the light by at most (d_max/d_min)³. Below this bound area sampling
-/// is nearly uniform in solid angle already and far cheaper (no trigonometry), so it is kept.
-const MIN_AREA_PDF_SPREAD: f64 = 2.0;
+/// is close enough to uniform in solid angle and far cheaper (no trigonometry), so it is kept.
+/// At 2 the f64 trigonometry cost 17-18% of the render time on the Cornell boxes of
+/// `bench/compare-mitsuba` for 4% less error (equal-error time 15% worse than area sampling,
+/// Zen 5, BENCHMARKS.md); at 8 it is used only near large lights, where it pays.
+const MIN_AREA_PDF_SPREAD: f64 = 8.0;
 
 /// A rectangular emitter: `corner + s ex + t ey` for s, t in [0, 1], with `ex ⟂ ey`, and
 /// `normal` the side its triangles face.
