@@ -6,7 +6,7 @@ use glint::build::BuildOptions;
 use glint::describe::Strategy;
 use glint::formats::{Define, ReadOptions};
 use glint::lights::LightSelection;
-use glint::render::{Aov, Rect};
+use glint::render::{Aov, Rect, Schedule};
 use glint::sampling::SamplerKind;
 use glint::session::Session;
 use std::path::PathBuf;
@@ -133,6 +133,10 @@ pub struct RunArgs {
     /// Write the raw film (same format as a checkpoint) when done, for `glint merge`.
     #[arg(long, value_name = "FILE")]
     pub film_out: Option<PathBuf>,
+    /// How paths are scheduled: one-path (each path to its end, the default) or wavefront
+    /// (a tile's paths advanced together, rays traced in batches). Same image either way.
+    #[arg(long, default_value = "one-path")]
+    pub schedule: Schedule,
 }
 
 #[derive(Args)]

@@ -179,6 +179,7 @@ fn run(
     };
     // What a checkpoint records is fixed for the whole render: work it out once.
     session.set_adaptive(adaptive);
+    session.set_schedule(job.run.schedule);
     let meta = session.film_meta(&film, Some(&job.output))?;
     let (mut last_checkpoint, mut last_preview) = (Instant::now(), Instant::now());
     let target = film.spp();

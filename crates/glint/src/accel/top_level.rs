@@ -107,6 +107,42 @@ impl TopLevelBvh {
         self.flat.as_ref().is_some_and(|f| f.occluded(ray, SimdPath::detect()))
     }
 
+    /// [`TopLevelBvh::intersect_flat`] of many rays at once (several traversals in flight per
+    /// thread, bit-identical answers); `hits[i]` is for `rays[i]`, which are not shortened.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_flat_batch(&self, rays: &[Ray], hits: &mut [Option<(u32, u32, TriangleHit)>]) {
+        assert_eq!(rays.len(), hits.len(), "intersect_flat_batch: one hit slot per ray");
+        let Some(flat) = &self.flat else {
+            hits.fill(None);
+            return;
+        };
+        let mut global = vec![None; rays.len()];
+        flat.intersect_batch(rays, &mut global, SimdPath::detect());
+        for (out, g) in hits.iter_mut().zip(global) {
+            *out = g.map(|(g, h)| {
+                let k = self.flat_offsets.partition_point(|&o| o <= g) - 1;
+                (self.flat_instances[k], g - self.flat_offsets[k], h)
+            });
+        }
+    }
+
+    /// [`TopLevelBvh::occluded_flat`] of many rays at once.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn occluded_flat_batch(&self, rays: &[Ray], blocked: &mut [bool]) {
+        assert_eq!(rays.len(), blocked.len(), "occluded_flat_batch: one answer per ray");
+        match &self.flat {
+            Some(flat) => flat.occluded_batch(rays, blocked, SimdPath::detect()),
+            None => blocked.fill(false),
+        }
+    }
+
+    /// Whether any instance is outside the flat BVH (in the tree the closures visit).
+    pub fn has_unflattened(&self) -> bool {
+        !self.rest.is_empty()
+    }
+
     pub fn stats(&self) -> BvhStats {
         self.binary.stats()
     }

@@ -6,12 +6,14 @@
 mod direct;
 mod first_hit;
 mod path;
+mod path_batch;
 mod surface;
 mod volpath;
 mod whitted;
 
 pub use crate::describe::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
+pub use path_batch::CameraSample;
 
 use crate::bsdf::ShadedBsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
@@ -61,6 +63,23 @@ impl Integrator {
             Integrator::Path(s) => path::li(s, scene, ray, rng, counters),
             Integrator::Direct(s) => direct::li(s, scene, ray, rng, counters),
             Integrator::Volpath(s) => volpath::li(s, scene, ray, rng, counters),
+        }
+    }
+
+    /// The radiance of many camera samples: `out[i]` is [`Integrator::li`] of `samples[i]`,
+    /// bit for bit. The path tracer advances the paths together (see `path_batch`); the
+    /// other integrators trace them one after another.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn li_batch(&self, scene: &World, samples: &mut [CameraSample], out: &mut [Rgb], counters: &mut Counters) {
+        assert_eq!(samples.len(), out.len(), "li_batch: one radiance per sample");
+        match self {
+            Integrator::Path(s) => path_batch::li_batch(s, scene, samples, out, counters),
+            _ => {
+                for (cs, o) in samples.iter_mut().zip(out.iter_mut()) {
+                    *o = self.li(scene, &cs.ray, &mut cs.sampler, counters);
+                }
+            }
         }
     }
 }

@@ -2,6 +2,12 @@
 //! sampling (power heuristic), Russian roulette on the path throughput, and unbounded depth
 //! by default. Depth counts path segments, as Mitsuba's `max_depth` does: 1 shows emitters
 //! seen directly, 2 adds direct lighting, and so on.
+//!
+//! A path is a [`PathState`] advanced one vertex at a time: [`PathState::step`] takes the hit
+//! of the path's ray and leaves the next ray to trace and, at most, one shadow ray whose
+//! answer [`PathState::resolve_shadow`] adds in. [`li`] traces those rays one at a time (the
+//! reference); `path_batch` traces many paths' rays together. Both run the same steps in the
+//! same order, so a path's radiance is the same bits either way.
 
 use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
@@ -11,86 +17,159 @@ use crate::describe::{PathSettings, Strategy};
 /// a path trapped between mirrors with a Russian roulette probability of 1 still ends. Light
 /// carried by longer paths is lost (a bias below throughput^4096).
 pub const MAX_PATH_DEPTH: u32 = 4096;
-use crate::math::{Ray, Rgb};
+use crate::math::{Ray, Rgb, Vec3};
 use crate::sampling::{power_heuristic, Sampler};
-use crate::world::World;
+use crate::world::{Hit, World};
 
 pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
-    let max_depth = s.max_depth.unwrap_or(MAX_PATH_DEPTH).min(MAX_PATH_DEPTH);
-    if max_depth == 0 {
-        return Rgb::BLACK;
+    let mut path = PathState::new(s, camera_ray);
+    while path.tracing {
+        let hit = path.trace(s, scene, c);
+        path.step(s, scene, hit, rng, c);
+        if let Some(shadow) = path.shadow.take() {
+            let visible = transmittance(scene, &shadow.ray, c);
+            path.resolve_shadow(&shadow, visible);
+        }
     }
-    let mut l = Rgb::BLACK;
-    let mut throughput = Rgb::WHITE;
-    // The product of eta^2 over the refractions so far: it undoes the 1/eta^2 radiance
-    // scaling in `throughput` for Russian roulette, as pbrt and Mitsuba do, so that paths
-    // inside glass are not killed for a scale factor that leaving the glass undoes.
-    let mut eta_scale = 1.0f32;
-    let mut ray = *camera_ray;
-    // Density of the BSDF sample that produced `ray` (solid angle) and whether it was delta;
-    // the camera ray behaves like a delta sample (nothing else could have produced it).
-    let mut prev_pdf = 1.0f32;
-    let mut prev_delta = true;
-    let mut prev_p = ray.origin;
-    let mut depth = 0u32; // segments traced so far
-    let mut mask_passes = 0u32;
+    path.l
+}
 
-    loop {
-        let hit = if depth == 0 {
-            // Hidden emitters are looked through by the camera ray (and not counted as depth).
-            camera_hit(scene, &ray, s.hide_emitters, c).map(|(r, h)| {
-                ray = r;
+/// A shadow ray of next-event estimation and what it adds if light gets along it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ShadowQuery {
+    pub ray: Ray,
+    /// Throughput x BSDF x emitted radiance, before the MIS weight and the light's density.
+    contribution: Rgb,
+    mis_weight: f32,
+    light_pdf: f32,
+}
+
+/// One path between vertices: what it has gathered and what it traces next.
+#[derive(Clone, Debug)]
+pub(crate) struct PathState {
+    /// Radiance gathered so far.
+    pub l: Rgb,
+    throughput: Rgb,
+    /// The product of eta^2 over the refractions so far: it undoes the 1/eta^2 radiance
+    /// scaling in `throughput` for Russian roulette, as pbrt and Mitsuba do, so that paths
+    /// inside glass are not killed for a scale factor that leaving the glass undoes.
+    eta_scale: f32,
+    /// The ray to trace next (when `tracing`).
+    pub ray: Ray,
+    /// Density of the BSDF sample that produced `ray` (solid angle) and whether it was
+    /// delta; the camera ray behaves like a delta sample (nothing else could have produced it).
+    prev_pdf: f32,
+    prev_delta: bool,
+    prev_p: Vec3,
+    /// Segments traced so far.
+    pub depth: u32,
+    mask_passes: u32,
+    max_depth: u32,
+    /// Whether `ray` is still to be traced; false once the path has ended.
+    pub tracing: bool,
+    /// The shadow ray the last step left, if any.
+    pub shadow: Option<ShadowQuery>,
+}
+
+impl PathState {
+    pub fn new(s: &PathSettings, camera_ray: &Ray) -> PathState {
+        let max_depth = s.max_depth.unwrap_or(MAX_PATH_DEPTH).min(MAX_PATH_DEPTH);
+        PathState {
+            l: Rgb::BLACK,
+            throughput: Rgb::WHITE,
+            eta_scale: 1.0,
+            ray: *camera_ray,
+            prev_pdf: 1.0,
+            prev_delta: true,
+            prev_p: camera_ray.origin,
+            depth: 0,
+            mask_passes: 0,
+            max_depth,
+            tracing: max_depth > 0,
+            shadow: None,
+        }
+    }
+
+    /// Whether the next ray is a camera ray that must look through hidden emitters (which
+    /// [`PathState::trace`] does one ray at a time).
+    pub fn traces_hidden_emitters(&self, s: &PathSettings) -> bool {
+        self.depth == 0 && s.hide_emitters
+    }
+
+    /// The closest hit of the path's next ray, traced alone. Hidden emitters are looked
+    /// through by the camera ray (which then replaces `ray`, and does not count as depth).
+    pub fn trace(&mut self, s: &PathSettings, scene: &World, c: &mut Counters) -> Option<Hit> {
+        if self.depth == 0 {
+            camera_hit(scene, &self.ray, s.hide_emitters, c).map(|(r, h)| {
+                self.ray = r;
                 h
             })
         } else {
             c.rays += 1;
-            scene.intersect(&ray)
-        };
-        depth += 1;
+            scene.intersect(&self.ray)
+        }
+    }
+
+    /// Adds a shadow ray's contribution, `visible` being the fraction of light that got along it.
+    #[inline]
+    pub fn resolve_shadow(&mut self, q: &ShadowQuery, visible: f32) {
+        if visible > 0.0 {
+            self.l += q.contribution * (q.mis_weight * visible / q.light_pdf);
+        }
+    }
+
+    /// One vertex: emission at `hit`, then (unless the path ends there) a shadow ray for
+    /// next-event estimation and the next ray by sampling the BSDF. Clears `tracing` when the
+    /// path ends. The caller resolves `shadow` before the next step.
+    pub fn step(&mut self, s: &PathSettings, scene: &World, hit: Option<Hit>, rng: &mut Sampler, c: &mut Counters) {
+        self.tracing = false;
+        self.depth += 1;
+        let ray = self.ray;
         let Some(hit) = hit else {
-            if !(depth == 1 && s.hide_emitters) {
+            if !(self.depth == 1 && s.hide_emitters) {
                 for &li_idx in &scene.environment_lights {
                     let light = &scene.lights[li_idx as usize];
                     let le = light.environment(ray.dir);
                     if le.is_black() {
                         continue;
                     }
-                    let w = emitter_weight(s.strategy, prev_delta, prev_pdf, || {
-                        scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, ray.origin, ray.dir)
+                    let w = emitter_weight(s.strategy, self.prev_delta, self.prev_pdf, || {
+                        scene.light_pmf(li_idx) * light.pdf_li(self.prev_p, ray.dir, ray.origin, ray.dir)
                     });
-                    l += throughput * le * w;
+                    self.l += self.throughput * le * w;
                 }
             }
-            break;
+            return;
         };
         let si = scene.interaction(&ray, &hit);
 
         if let Some(li_idx) = si.light {
-            if !(depth == 1 && s.hide_emitters) {
+            if !(self.depth == 1 && s.hide_emitters) {
                 let light = &scene.lights[li_idx as usize];
                 let le = scene.emitted(&si, ray.dir);
                 if !le.is_black() {
-                    let w = emitter_weight(s.strategy, prev_delta, prev_pdf, || {
-                        scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, si.p, si.ng)
+                    let w = emitter_weight(s.strategy, self.prev_delta, self.prev_pdf, || {
+                        scene.light_pmf(li_idx) * light.pdf_li(self.prev_p, ray.dir, si.p, si.ng)
                     });
-                    l += throughput * le * w;
+                    self.l += self.throughput * le * w;
                 }
             }
         }
         // A masked surface lets the path through unscattered with probability 1 - opacity.
         // Passing is not a bounce: depth, the MIS state and the previous vertex stay as
         // they were (shadow rays from that vertex crossed the surface the same way).
-        if scene.has_masks && mask_passes < MAX_MASK_PASSES {
+        if scene.has_masks && self.mask_passes < MAX_MASK_PASSES {
             let o = opacity(scene, &si);
             if o < 1.0 && rng.next_f32() >= o {
-                mask_passes += 1;
-                depth -= 1;
-                ray = spawn_ray(&si, ray.dir);
-                continue;
+                self.mask_passes += 1;
+                self.depth -= 1;
+                self.ray = spawn_ray(&si, ray.dir);
+                self.tracing = true;
+                return;
             }
         }
-        if depth >= max_depth {
-            break;
+        if self.depth >= self.max_depth {
+            return;
         }
 
         let wo_world = -ray.dir;
@@ -112,16 +191,18 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
                         let f = bsdf.eval(wo, wi);
                         if !f.is_black() {
                             c.shadow_rays += 1;
-                            let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
-                            if visible > 0.0 {
-                                let light_pdf = pick.pmf * ls.pdf;
-                                let w = if ls.delta || s.strategy == Strategy::Light {
-                                    1.0
-                                } else {
-                                    power_heuristic(light_pdf, bsdf.pdf(wo, wi))
-                                };
-                                l += throughput * f * ls.radiance * (w * visible / light_pdf);
-                            }
+                            let light_pdf = pick.pmf * ls.pdf;
+                            let mis_weight = if ls.delta || s.strategy == Strategy::Light {
+                                1.0
+                            } else {
+                                power_heuristic(light_pdf, bsdf.pdf(wo, wi))
+                            };
+                            self.shadow = Some(ShadowQuery {
+                                ray: shadow_ray(&si, ls.wi, ls.dist),
+                                contribution: self.throughput * f * ls.radiance,
+                                mis_weight,
+                                light_pdf,
+                            });
                         }
                     }
                 }
@@ -132,31 +213,31 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
         let u_lobe = rng.next_f32();
         let u = rng.next_2d();
         let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
-            break;
+            return;
         };
         if bs.weight.is_black() {
-            break;
+            return;
         }
-        throughput *= bs.weight;
-        eta_scale *= bs.eta * bs.eta;
+        self.throughput *= bs.weight;
+        self.eta_scale *= bs.eta * bs.eta;
         let wi_world = frame.to_world(bs.wi);
-        prev_pdf = bs.pdf;
-        prev_delta = bs.delta;
-        prev_p = si.p;
-        ray = spawn_ray(&si, wi_world);
+        self.prev_pdf = bs.pdf;
+        self.prev_delta = bs.delta;
+        self.prev_p = si.p;
+        self.ray = spawn_ray(&si, wi_world);
 
-        if depth >= s.rr_depth {
+        if self.depth >= s.rr_depth {
             let q = match s.rr_probability {
                 Some(p) => p,
-                None => (throughput.max_component() * eta_scale).min(0.95),
+                None => (self.throughput.max_component() * self.eta_scale).min(0.95),
             };
             if q <= 0.0 || rng.next_f32() >= q {
-                break;
+                return;
             }
-            throughput = throughput / q;
+            self.throughput = self.throughput / q;
         }
+        self.tracing = true;
     }
-    l
 }
 
 /// MIS weight of an emitter reached by a BSDF-sampled ray. `light_pdf` is only evaluated

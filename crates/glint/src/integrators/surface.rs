@@ -30,7 +30,12 @@ pub(crate) fn opacity(scene: &World, si: &SurfaceInteraction) -> f32 {
 /// otherwise (the expected value of passing each one, as Mitsuba's volumetric path tracer
 /// counts null surfaces; its `path` integrator stops shadow rays at every surface).
 pub(crate) fn transmittance(scene: &World, ray: &Ray, c: &mut Counters) -> f32 {
-    if !scene.occluded(ray) {
+    transmittance_if_blocked(scene, ray, scene.occluded(ray), c)
+}
+
+/// [`transmittance`] of a ray whose occlusion query has already answered `blocked`.
+pub(crate) fn transmittance_if_blocked(scene: &World, ray: &Ray, blocked: bool, c: &mut Counters) -> f32 {
+    if !blocked {
         return 1.0;
     }
     if !scene.has_masks {

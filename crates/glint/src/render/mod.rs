@@ -31,7 +31,37 @@ pub struct RenderSettings {
     /// Also return the per-pixel variance of the mean (for statistical tests).
     pub variance: bool,
     pub tile_size: usize,
+    /// How paths are scheduled; the image is the same bits either way.
+    pub schedule: Schedule,
 }
+
+/// How a thread schedules its camera samples' paths. The integrators' answers are the same
+/// bits under both, so this trades only speed (BENCHMARKS.md, "Many paths in flight").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Schedule {
+    /// Each path traced to its end before the next starts (the reference).
+    #[default]
+    OnePath,
+    /// Up to [`WAVEFRONT_PATHS`] paths of a tile advanced together, their rays traced in
+    /// batches (only the path tracer batches; other integrators run one path at a time).
+    Wavefront,
+}
+
+impl std::str::FromStr for Schedule {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "one-path" => Ok(Schedule::OnePath),
+            "wavefront" => Ok(Schedule::Wavefront),
+            _ => Err(format!("unknown schedule '{s}' (expected one-path or wavefront)")),
+        }
+    }
+}
+
+/// Paths a thread advances together under [`Schedule::Wavefront`]: enough to keep the batch
+/// traversal's lanes busy until the last bounces, few enough that their state stays in L2.
+pub const WAVEFRONT_PATHS: usize = 1024;
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -42,6 +72,7 @@ impl Default for RenderSettings {
             sampler: SamplerKind::Sobol,
             variance: false,
             tile_size: 16,
+            schedule: Schedule::OnePath,
         }
     }
 }

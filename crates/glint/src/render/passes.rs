@@ -4,9 +4,9 @@
 
 use super::film::{to_fixed, Block, Film, PixelSums, Rect};
 use super::splat::{splat_margin, SplatBuffer};
-use super::{Aov, Progress, RenderSettings, RenderStats};
-use crate::integrators::{closest_hit_cost, first_hit, Counters, Integrator};
-use crate::math::Rgb;
+use super::{Aov, Progress, RenderSettings, RenderStats, Schedule, WAVEFRONT_PATHS};
+use crate::integrators::{closest_hit_cost, first_hit, CameraSample, Counters, Integrator};
+use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::world::World;
 use rayon::prelude::*;
@@ -206,6 +206,7 @@ impl PassJob<'_> {
                 y1: y1.saturating_add(m).min(film_rect.y1),
             })
         });
+        let mut wave = Wave::default();
         let mut x0 = self.region.x0;
         while x0 < self.region.x1 {
             let x1 = (x0 + self.tile).min(self.region.x1);
@@ -216,10 +217,27 @@ impl PassJob<'_> {
                     if converged[i] {
                         continue;
                     }
-                    let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];
-                    self.pixel(x, y, &mut pixels[i], aov, band_splat.as_mut(), &mut counts);
+                    for s in self.samples.clone() {
+                        let (origin, camera) = self.camera_sample(x, y, s);
+                        match self.settings.schedule {
+                            Schedule::OnePath => {
+                                let mut cs = camera;
+                                let l = self.integrator.li(self.scene, &cs.ray, &mut cs.sampler, &mut counts.counters);
+                                let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];
+                                self.record(&origin, &cs.ray, l, &mut pixels[i], aov, band_splat.as_mut(), &mut counts);
+                            }
+                            Schedule::Wavefront => {
+                                wave.origins.push(SampleOrigin { index: i, ..origin });
+                                wave.cameras.push(camera);
+                                if wave.cameras.len() >= WAVEFRONT_PATHS {
+                                    self.flush(&mut wave, pixels, aov_sums, band_splat.as_mut(), &mut counts);
+                                }
+                            }
+                        }
+                    }
                 }
             }
+            self.flush(&mut wave, pixels, aov_sums, band_splat.as_mut(), &mut counts);
             let rays = counts.counters.rays + counts.counters.shadow_rays - rays_before;
             self.progress.advance(((x1 - x0) * (y1 - y0)) as u64, rays);
             x0 = x1;
@@ -230,53 +248,96 @@ impl PassJob<'_> {
         counts
     }
 
-    fn pixel(
+    /// The camera ray of sample `s` of pixel (x, y), and its sampler for the integrator.
+    fn camera_sample(&self, x: u32, y: u32, s: u32) -> (SampleOrigin, CameraSample) {
+        let (scene, settings) = (self.scene, self.settings);
+        let pixel = y as u64 * scene.camera.width as u64 + x as u64;
+        let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
+        // Uniform in the pixel; a splatting filter spreads the sample over its neighbours.
+        let u = rng.next_2d();
+        let (px, py) = (x as f32 + 0.5 + (u[0] - 0.5), y as f32 + 0.5 + (u[1] - 0.5));
+        let lens = rng.next_2d();
+        let ray = scene.camera.generate_ray(px, py, lens);
+        (SampleOrigin { index: 0, px, py }, CameraSample { ray, sampler: rng })
+    }
+
+    /// Traces the wave's paths together and records them in the order they were queued.
+    fn flush(
         &self,
-        x: u32,
-        y: u32,
-        sums: &mut PixelSums,
+        wave: &mut Wave,
+        pixels: &mut [PixelSums],
         aov_sums: &mut [i128],
         mut splat: Option<&mut SplatBuffer>,
         counts: &mut TileCounts,
     ) {
-        let (scene, settings) = (self.scene, self.settings);
-        let pixel = y as u64 * scene.camera.width as u64 + x as u64;
-        for s in self.samples.clone() {
-            let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
-            // Uniform in the pixel; a splatting filter spreads the sample over its neighbours.
-            let u = rng.next_2d();
-            let (px, py) = (x as f32 + 0.5 + (u[0] - 0.5), y as f32 + 0.5 + (u[1] - 0.5));
-            let lens = rng.next_2d();
-            let ray = scene.camera.generate_ray(px, py, lens);
-            let mut l = self.integrator.li(scene, &ray, &mut rng, &mut counts.counters);
-            if !l.is_finite() || l.r < 0.0 || l.g < 0.0 || l.b < 0.0 {
-                counts.discarded += 1;
-                l = Rgb::BLACK;
-            }
-            sums.add_sample(l);
-            if let Some(buffer) = splat.as_deref_mut() {
-                buffer.splat(&self.filter, px, py, l);
-            }
-            counts.camera_rays += 1;
-            if self.layers.is_empty() {
-                continue;
-            }
-            let hit = if self.wants_first_hit { first_hit(scene, &ray) } else { crate::integrators::FirstHit::NONE };
-            for &(aov, off) in self.layers {
-                let values: [f32; 3] = match aov {
-                    Aov::Albedo => hit.albedo.to_array(),
-                    Aov::Normal => hit.normal.to_array(),
-                    Aov::Position => hit.position.to_array(),
-                    Aov::Depth => [hit.depth, 0.0, 0.0],
-                    Aov::BvhCost => [closest_hit_cost(scene, &ray) as f32, 0.0, 0.0],
-                    Aov::Variance | Aov::Spp => continue,
-                };
-                for c in 0..aov.stored_channels() {
-                    aov_sums[off + c] = aov_sums[off + c].saturating_add(to_fixed(values[c] as f64));
-                }
+        wave.radiance.clear();
+        wave.radiance.resize(wave.cameras.len(), Rgb::BLACK);
+        self.integrator.li_batch(self.scene, &mut wave.cameras, &mut wave.radiance, &mut counts.counters);
+        for ((origin, camera), &l) in wave.origins.iter().zip(&wave.cameras).zip(&wave.radiance) {
+            let i = origin.index;
+            let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];
+            self.record(origin, &camera.ray, l, &mut pixels[i], aov, splat.as_deref_mut(), counts);
+        }
+        wave.origins.clear();
+        wave.cameras.clear();
+    }
+
+    /// Adds one sample's radiance (and its AOVs) to its pixel.
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &self,
+        origin: &SampleOrigin,
+        ray: &Ray,
+        mut l: Rgb,
+        sums: &mut PixelSums,
+        aov_sums: &mut [i128],
+        splat: Option<&mut SplatBuffer>,
+        counts: &mut TileCounts,
+    ) {
+        let scene = self.scene;
+        if !l.is_finite() || l.r < 0.0 || l.g < 0.0 || l.b < 0.0 {
+            counts.discarded += 1;
+            l = Rgb::BLACK;
+        }
+        sums.add_sample(l);
+        if let Some(buffer) = splat {
+            buffer.splat(&self.filter, origin.px, origin.py, l);
+        }
+        counts.camera_rays += 1;
+        if self.layers.is_empty() {
+            return;
+        }
+        let hit = if self.wants_first_hit { first_hit(scene, ray) } else { crate::integrators::FirstHit::NONE };
+        for &(aov, off) in self.layers {
+            let values: [f32; 3] = match aov {
+                Aov::Albedo => hit.albedo.to_array(),
+                Aov::Normal => hit.normal.to_array(),
+                Aov::Position => hit.position.to_array(),
+                Aov::Depth => [hit.depth, 0.0, 0.0],
+                Aov::BvhCost => [closest_hit_cost(scene, ray) as f32, 0.0, 0.0],
+                Aov::Variance | Aov::Spp => continue,
+            };
+            for c in 0..aov.stored_channels() {
+                aov_sums[off + c] = aov_sums[off + c].saturating_add(to_fixed(values[c] as f64));
             }
         }
     }
+}
+
+/// Where a camera sample lands: its pixel (index in the band) and its film position.
+#[derive(Clone, Copy, Debug)]
+struct SampleOrigin {
+    index: usize,
+    px: f32,
+    py: f32,
+}
+
+/// Camera samples queued for [`Schedule::Wavefront`], and room for their radiance.
+#[derive(Default)]
+struct Wave {
+    origins: Vec<SampleOrigin>,
+    cameras: Vec<CameraSample>,
+    radiance: Vec<Rgb>,
 }
 
 /// After a pass, stops the pixels whose mean is known well enough.

@@ -44,7 +44,7 @@ use crate::formats::{read, ReadOptions};
 use crate::integrators::Integrator;
 use crate::render::{
     read_film, render_passes, write_film, Adaptive, Aov, ContentHash, Film, FilmMeta, PassRequest, Progress, Rect,
-    RenderSettings, RenderStats,
+    RenderSettings, RenderStats, Schedule,
 };
 use crate::world::World;
 use std::collections::BTreeSet;
@@ -110,6 +110,8 @@ pub struct Session {
     instanced: BTreeSet<usize>,
     /// Adaptive settings of the film being rendered (stored in its checkpoints).
     adaptive: Option<Adaptive>,
+    /// How paths are scheduled (speed only: the image is the same bits).
+    schedule: Schedule,
 }
 
 impl Session {
@@ -127,7 +129,14 @@ impl Session {
             layout: None,
             instanced: BTreeSet::new(),
             adaptive: None,
+            schedule: Schedule::default(),
         }
+    }
+
+    /// How the render schedules paths: one at a time or many in flight. The image is the
+    /// same bits either way.
+    pub fn set_schedule(&mut self, schedule: Schedule) {
+        self.schedule = schedule;
     }
 
     pub fn description(&self) -> &SceneDesc {
@@ -176,6 +185,7 @@ impl Session {
             seed: self.desc.sampler.seed,
             filter: self.desc.film.filter,
             sampler: self.desc.sampler.kind,
+            schedule: self.schedule,
             ..RenderSettings::default()
         }
     }

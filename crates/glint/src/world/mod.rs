@@ -181,14 +181,56 @@ impl World {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut r = *ray;
-        let mut best: Option<Hit> = self.top.intersect_flat(&mut r).map(|(instance, prim, h)| Hit {
+        let best: Option<Hit> = self.top.intersect_flat(&mut r).map(|(instance, prim, h)| Hit {
             t: h.t,
             instance,
             prim,
             b1: h.b1,
             b2: h.b2,
         });
-        self.top.traverse(&mut r, |inst_idx, r| {
+        self.intersect_unflattened(&mut r, best)
+    }
+
+    /// Closest hits of many rays: `hits[i]` is [`World::intersect`] of `rays[i]`, bit for bit.
+    /// The flat BVH (all of a scene's untransformed meshes) traces several rays in flight per
+    /// thread; the instances outside it are then traced one ray at a time.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_batch(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "intersect_batch: one hit slot per ray");
+        let mut flat = vec![None; rays.len()];
+        self.top.intersect_flat_batch(rays, &mut flat);
+        let rest = self.top.has_unflattened();
+        for ((ray, f), out) in rays.iter().zip(flat).zip(hits.iter_mut()) {
+            let best = f.map(|(instance, prim, h)| Hit { t: h.t, instance, prim, b1: h.b1, b2: h.b2 });
+            *out = if rest {
+                // As the single-ray flat traversal leaves it: shortened to the hit.
+                let mut r = Ray { t_max: best.map_or(ray.t_max, |h| h.t), ..*ray };
+                self.intersect_unflattened(&mut r, best)
+            } else {
+                best
+            };
+        }
+    }
+
+    /// Whether each ray is blocked: `blocked[i]` is [`World::occluded`] of `rays[i]`.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn occluded_batch(&self, rays: &[Ray], blocked: &mut [bool]) {
+        assert_eq!(rays.len(), blocked.len(), "occluded_batch: one answer per ray");
+        self.top.occluded_flat_batch(rays, blocked);
+        if self.top.has_unflattened() {
+            for (ray, b) in rays.iter().zip(blocked.iter_mut()) {
+                *b = *b || self.occluded_unflattened(ray);
+            }
+        }
+    }
+
+    /// The closest hit among the instances outside the flat BVH, or `best` (the flat BVH's,
+    /// whose distance `r.t_max` already is) when none is nearer.
+    #[inline]
+    fn intersect_unflattened(&self, r: &mut Ray, mut best: Option<Hit>) -> Option<Hit> {
+        self.top.traverse(r, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
             if let Some(h) = self.intersect_instance(inst, r) {
                 r.t_max = h.t;
@@ -227,9 +269,12 @@ impl World {
     /// True when anything blocks the ray within its interval.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if self.top.occluded_flat(ray) {
-            return true;
-        }
+        self.top.occluded_flat(ray) || self.occluded_unflattened(ray)
+    }
+
+    /// Whether an instance outside the flat BVH blocks the ray.
+    #[inline]
+    fn occluded_unflattened(&self, ray: &Ray) -> bool {
         self.top.occluded(ray, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
             match inst.shape {

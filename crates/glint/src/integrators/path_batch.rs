@@ -1,0 +1,78 @@
+//! Many paths advanced together (wavefront style): every live path's ray is traced in one
+//! batch, every path then takes one step, the shadow rays those steps leave are traced in a
+//! second batch, and the paths that ended drop out. The batches go through the world's batch
+//! traversal, which keeps several rays in flight per thread.
+//!
+//! Each path runs the steps of the one-path tracer ([`super::path::li`]) with the same
+//! sampler in the same order, and each batch query answers as the single-ray query does, so
+//! every path's radiance is the same bits either way (tests/wavefront.rs checks this).
+
+use super::path::PathState;
+use super::surface::transmittance_if_blocked;
+use super::Counters;
+use crate::describe::PathSettings;
+use crate::math::{Ray, Rgb};
+use crate::sampling::Sampler;
+use crate::world::{Hit, World};
+
+/// A camera ray and the sampler of its pixel sample (already past the camera's dimensions).
+pub struct CameraSample {
+    pub ray: Ray,
+    pub sampler: Sampler,
+}
+
+/// The radiance of every sample's path: `out[i]` is `path::li` of `samples[i]`, bit for bit.
+///
+/// Panics if the slices differ in length.
+pub fn li_batch(s: &PathSettings, scene: &World, samples: &mut [CameraSample], out: &mut [Rgb], c: &mut Counters) {
+    assert_eq!(samples.len(), out.len(), "li_batch: one radiance per sample");
+    let mut paths: Vec<PathState> = samples.iter().map(|cs| PathState::new(s, &cs.ray)).collect();
+    let mut live: Vec<usize> = (0..paths.len()).filter(|&i| paths[i].tracing).collect();
+    let mut rays: Vec<Ray> = Vec::with_capacity(live.len());
+    let mut hits: Vec<Option<Hit>> = Vec::with_capacity(live.len());
+    let mut shadowed: Vec<usize> = Vec::with_capacity(live.len());
+    let mut blocked: Vec<bool> = Vec::with_capacity(live.len());
+    while !live.is_empty() {
+        // Camera rays that look through hidden emitters are traced one at a time (below).
+        rays.clear();
+        rays.extend(live.iter().map(|&i| &paths[i]).filter(|p| !p.traces_hidden_emitters(s)).map(|p| p.ray));
+        hits.clear();
+        hits.resize(rays.len(), None);
+        scene.intersect_batch(&rays, &mut hits);
+        c.rays += rays.len() as u64;
+
+        let mut batched = hits.iter();
+        for &i in &live {
+            let path = &mut paths[i];
+            let hit = if path.traces_hidden_emitters(s) {
+                path.trace(s, scene, c)
+            } else {
+                *batched.next().expect("one batched hit per path traced in the batch")
+            };
+            path.step(s, scene, hit, &mut samples[i].sampler, c);
+        }
+
+        shadowed.clear();
+        rays.clear();
+        for &i in &live {
+            if let Some(q) = &paths[i].shadow {
+                shadowed.push(i);
+                rays.push(q.ray);
+            }
+        }
+        blocked.clear();
+        blocked.resize(rays.len(), false);
+        scene.occluded_batch(&rays, &mut blocked);
+        for (&i, &b) in shadowed.iter().zip(&blocked) {
+            let path = &mut paths[i];
+            if let Some(q) = path.shadow.take() {
+                let visible = transmittance_if_blocked(scene, &q.ray, b, c);
+                path.resolve_shadow(&q, visible);
+            }
+        }
+        live.retain(|&i| paths[i].tracing);
+    }
+    for (o, p) in out.iter_mut().zip(&paths) {
+        *o = p.l;
+    }
+}
