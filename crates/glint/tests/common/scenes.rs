@@ -9,7 +9,7 @@ use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::{AreaEmission, LightSelection};
 use glint::materials::{Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
-use glint::render::{render, PixelFilter, RenderOutput, RenderSettings, Silent};
+use glint::render::{render, PixelFilter, RenderOutput, RenderSettings, Schedule, Silent};
 use glint::sampling::SamplerKind;
 use glint::world::World;
 use std::sync::Arc;
@@ -31,6 +31,7 @@ pub fn settings(spp: u32, seed: u64) -> RenderSettings {
         sampler: SamplerKind::Independent,
         variance: true,
         tile_size: 4,
+        schedule: Schedule::OnePath,
     }
 }
 
@@ -38,10 +39,34 @@ pub fn path(strategy: Strategy) -> Integrator {
     Integrator::Path(PathSettings { strategy, ..PathSettings::default() })
 }
 
+/// Renders with both path schedules, checks that they give the same bits, and returns the
+/// image: so every validation test that renders through here holds for both.
 pub fn render_with(scene: &World, integrator: &Integrator, spp: u32, seed: u64) -> RenderOutput {
     let out = render(scene, integrator, &settings(spp, seed), &Silent);
     assert_eq!(out.stats.discarded_samples, 0, "the renderer produced NaN, infinite or negative samples");
+    let wave =
+        render(scene, integrator, &RenderSettings { schedule: Schedule::Wavefront, ..settings(spp, seed) }, &Silent);
+    assert_same_bits(&out, &wave);
     out
+}
+
+/// Asserts two renders gave the same image, variance and ray counts, bit for bit.
+pub fn assert_same_bits(a: &RenderOutput, b: &RenderOutput) {
+    let bits = |o: &RenderOutput| -> Vec<u32> {
+        let mut v: Vec<u32> = o.image.pixels.iter().flat_map(|p| p.to_array()).map(f32::to_bits).collect();
+        if let Some(var) = &o.variance {
+            v.extend(var.pixels.iter().flat_map(|p| p.to_array()).map(f32::to_bits));
+        }
+        v
+    };
+    let (x, y) = (bits(a), bits(b));
+    let differ = x.iter().zip(&y).filter(|(p, q)| p != q).count();
+    assert!(x.len() == y.len() && differ == 0, "the schedules' images differ in {differ} of {} values", x.len());
+    assert_eq!(
+        (a.stats.camera_rays, a.stats.rays, a.stats.shadow_rays),
+        (b.stats.camera_rays, b.stats.rays, b.stats.shadow_rays),
+        "the schedules traced different numbers of rays"
+    );
 }
 
 pub fn emission(radiance: f32) -> Option<AreaEmission> {
