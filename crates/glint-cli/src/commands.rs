@@ -133,9 +133,9 @@ pub struct RunArgs {
     /// Write the raw film (same format as a checkpoint) when done, for `glint merge`.
     #[arg(long, value_name = "FILE")]
     pub film_out: Option<PathBuf>,
-    /// How paths are scheduled: one-path (each path to its end, the default) or wavefront
-    /// (a tile's paths advanced together, rays traced in batches). Same image either way.
-    #[arg(long, default_value = "one-path")]
+    /// How paths are scheduled: wavefront (a tile's paths advanced together, rays traced in
+    /// batches; the default) or one-path (each path to its end). Same image either way.
+    #[arg(long, default_value = "wavefront")]
     pub schedule: Schedule,
 }
 

@@ -40,11 +40,13 @@ pub struct RenderSettings {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Schedule {
-    /// Each path traced to its end before the next starts (the reference).
-    #[default]
+    /// Each path traced to its end before the next starts (the reference the tests compare
+    /// the wavefront against).
     OnePath,
     /// Up to [`WAVEFRONT_PATHS`] paths of a tile advanced together, their rays traced in
     /// batches (only the path tracer batches; other integrators run one path at a time).
+    /// The default: 1.00-1.12x the one-path schedule's speed (BENCHMARKS.md).
+    #[default]
     Wavefront,
 }
 
@@ -72,7 +74,7 @@ impl Default for RenderSettings {
             sampler: SamplerKind::Sobol,
             variance: false,
             tile_size: 16,
-            schedule: Schedule::OnePath,
+            schedule: Schedule::Wavefront,
         }
     }
 }
