@@ -32,6 +32,7 @@ pub fn li_batch(s: &PathSettings, scene: &World, samples: &mut [CameraSample], o
     let mut hits: Vec<Option<Hit>> = Vec::with_capacity(live.len());
     let mut shadowed: Vec<usize> = Vec::with_capacity(live.len());
     let mut blocked: Vec<bool> = Vec::with_capacity(live.len());
+    let mut stepping: Vec<Stepping> = Vec::with_capacity(live.len());
     while !live.is_empty() {
         // Camera rays that look through hidden emitters are traced one at a time (below).
         rays.clear();
@@ -41,22 +42,28 @@ pub fn li_batch(s: &PathSettings, scene: &World, samples: &mut [CameraSample], o
         scene.intersect_batch(&rays, &mut hits);
         c.rays += rays.len() as u64;
 
+        // Paths step grouped by the instance they hit, so that consecutive steps run the same
+        // material and light code (paths are independent: the order changes no path's bits).
         let mut batched = hits.iter();
+        stepping.clear();
         for &i in &live {
-            let path = &mut paths[i];
-            let hit = if path.traces_hidden_emitters(s) {
-                path.trace(s, scene, c)
+            let hit = if paths[i].traces_hidden_emitters(s) {
+                paths[i].trace(s, scene, c)
             } else {
                 *batched.next().expect("one batched hit per path traced in the batch")
             };
-            path.step(s, scene, hit, &mut samples[i].sampler, c);
+            stepping.push(Stepping { key: hit.map_or(u32::MAX, |h| h.instance), path: i, hit });
+        }
+        stepping.sort_unstable_by_key(|st| st.key);
+        for st in &stepping {
+            paths[st.path].step(s, scene, st.hit, &mut samples[st.path].sampler, c);
         }
 
         shadowed.clear();
         rays.clear();
-        for &i in &live {
-            if let Some(q) = &paths[i].shadow {
-                shadowed.push(i);
+        for st in &stepping {
+            if let Some(q) = &paths[st.path].shadow {
+                shadowed.push(st.path);
                 rays.push(q.ray);
             }
         }
@@ -75,4 +82,12 @@ pub fn li_batch(s: &PathSettings, scene: &World, samples: &mut [CameraSample], o
     for (o, p) in out.iter_mut().zip(&paths) {
         *o = p.l;
     }
+}
+
+/// A path about to take its step, and the hit it takes it at.
+struct Stepping {
+    /// What the paths are grouped by: the instance hit (misses last).
+    key: u32,
+    path: usize,
+    hit: Option<Hit>,
 }
