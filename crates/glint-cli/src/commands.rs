@@ -133,8 +133,9 @@ pub struct RunArgs {
     /// Write the raw film (same format as a checkpoint) when done, for `glint merge`.
     #[arg(long, value_name = "FILE")]
     pub film_out: Option<PathBuf>,
-    /// How paths are scheduled: wavefront (a tile's paths advanced together, rays traced in
-    /// batches; the default) or one-path (each path to its end). Same image either way.
+    /// How paths are scheduled: wavefront (a tile's paths advanced together, a bounce at a
+    /// time; the default), wavefront-interleaved (the same, each batch traced with several
+    /// rays in flight) or one-path (each path to its end). Same image under each.
     #[arg(long, default_value = "wavefront")]
     pub schedule: Schedule,
 }

@@ -1,15 +1,15 @@
-//! The wavefront schedule (a tile's paths advanced together, their rays traced in batches)
-//! against the one-path reference:
+//! The wavefront schedules (a tile's paths advanced together, their rays traced in batches
+//! one by one or interleaved) against the one-path reference:
 //! - the world's batch queries give every ray the single-ray answer, bit for bit, on a world
 //!   with a flat BVH of meshes and instances outside it (spheres, a transformed mesh), for
 //!   random rays including NaN, infinite and zero directions and intervals, and rays grazing
 //!   the walls in their plane;
-//! - renders give the same bits and the same ray counts under both schedules: the path tracer
+//! - renders give the same bits and the same ray counts under every schedule: the path tracer
 //!   with every strategy, hidden emitters, depth limits and fixed Russian roulette on a scene
 //!   with glass, metal and instances, at tile sizes and sample counts that fill, split and
 //!   leave part-full waves; and every Mitsuba agreement scene (masks, textures, media,
 //!   instances, every light) as its file asks. (Every statistical test that renders through
-//!   `common::scenes::render_with` also checks both schedules.)
+//!   `common::scenes::render_with` also checks every schedule.)
 
 mod common;
 
@@ -109,15 +109,16 @@ fn batch_queries_see_the_instances_outside_the_flat_bvh() {
     assert!(blocked[0], "the ball blocks the segment");
 }
 
-fn render_both(world: &World, integrator: &Integrator, settings: &RenderSettings) -> (RenderOutput, RenderOutput) {
+/// The one-path render and the two wavefront renders, which must match it.
+fn render_all(world: &World, integrator: &Integrator, settings: &RenderSettings) -> (RenderOutput, Vec<RenderOutput>) {
     let one = render(world, integrator, &RenderSettings { schedule: Schedule::OnePath, ..settings.clone() }, &Silent);
-    let wave =
-        render(world, integrator, &RenderSettings { schedule: Schedule::Wavefront, ..settings.clone() }, &Silent);
-    (one, wave)
+    let waves = [Schedule::Wavefront, Schedule::WavefrontInterleaved]
+        .map(|schedule| render(world, integrator, &RenderSettings { schedule, ..settings.clone() }, &Silent));
+    (one, waves.into())
 }
 
 #[test]
-fn path_tracer_gives_the_same_bits_on_both_schedules() {
+fn path_tracer_gives_the_same_bits_on_every_schedule() {
     let world = scene();
     let variants = [
         PathSettings { strategy: Strategy::Mis, ..Default::default() },
@@ -135,14 +136,14 @@ fn path_tracer_gives_the_same_bits_on_both_schedules() {
         let integrator = Integrator::Path(p.clone());
         let (tile_size, spp) = layouts[k % layouts.len()];
         let settings = RenderSettings { spp, seed: 5, tile_size, variance: true, ..Default::default() };
-        let (one, wave) = render_both(world, &integrator, &settings);
+        let (one, waves) = render_all(world, &integrator, &settings);
         assert!(one.image.pixels.iter().any(|p| p.max_component() > 0.0), "{p:?}: black image");
-        assert_same_bits(&one, &wave);
+        waves.iter().for_each(|w| assert_same_bits(&one, w));
     }
 }
 
 #[test]
-fn every_agreement_scene_gives_the_same_bits_on_both_schedules() {
+fn every_agreement_scene_gives_the_same_bits_on_every_schedule() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/scenes/mitsuba");
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
@@ -155,8 +156,8 @@ fn every_agreement_scene_gives_the_same_bits_on_both_schedules() {
         // Small images (a cropped film keeps its own size: its crop window needs it).
         let loaded = load(f, &[], Some((24, 18))).or_else(|_| load(f, &[], None)).unwrap();
         let settings = RenderSettings { spp: 3, tile_size: 8, variance: true, ..loaded.settings.clone() };
-        let (one, wave) = render_both(&loaded.world, &loaded.integrator, &settings);
-        assert_same_bits(&one, &wave);
+        let (one, waves) = render_all(&loaded.world, &loaded.integrator, &settings);
+        waves.iter().for_each(|w| assert_same_bits(&one, w));
         eprintln!("{}: same bits ({} rays)", f.display(), one.stats.rays + one.stats.shadow_rays);
     }
 }

@@ -18,7 +18,7 @@ pub use path_batch::CameraSample;
 use crate::bsdf::ShadedBsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::sampling::Sampler;
-use crate::world::{Hit, SurfaceInteraction, World};
+use crate::world::{BatchTraversal, Hit, SurfaceInteraction, World};
 
 /// Per-thread counters, summed at the end of a render.
 #[derive(Clone, Copy, Debug, Default)]
@@ -71,10 +71,17 @@ impl Integrator {
     /// other integrators trace them one after another.
     ///
     /// Panics if the slices differ in length.
-    pub fn li_batch(&self, scene: &World, samples: &mut [CameraSample], out: &mut [Rgb], counters: &mut Counters) {
+    pub fn li_batch(
+        &self,
+        scene: &World,
+        traversal: BatchTraversal,
+        samples: &mut [CameraSample],
+        out: &mut [Rgb],
+        counters: &mut Counters,
+    ) {
         assert_eq!(samples.len(), out.len(), "li_batch: one radiance per sample");
         match self {
-            Integrator::Path(s) => path_batch::li_batch(s, scene, samples, out, counters),
+            Integrator::Path(s) => path_batch::li_batch(s, scene, traversal, samples, out, counters),
             _ => {
                 for (cs, o) in samples.iter_mut().zip(out.iter_mut()) {
                     *o = self.li(scene, &cs.ray, &mut cs.sampler, counters);

@@ -1,7 +1,8 @@
 //! Many paths advanced together (wavefront style): every live path's ray is traced in one
 //! batch, every path then takes one step, the shadow rays those steps leave are traced in a
-//! second batch, and the paths that ended drop out. The batches go through the world's batch
-//! traversal, which keeps several rays in flight per thread.
+//! second batch, and the paths that ended drop out. The batches go through the single-ray
+//! kernels one ray after another or through the world's interleaved batch traversal (several
+//! rays in flight per thread), as the caller asks.
 //!
 //! Each path runs the steps of the one-path tracer ([`super::path::li`]) with the same
 //! sampler in the same order, and each batch query answers as the single-ray query does, so
@@ -13,7 +14,7 @@ use super::Counters;
 use crate::describe::PathSettings;
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
-use crate::world::{Hit, World};
+use crate::world::{BatchTraversal, Hit, World};
 
 /// A camera ray and the sampler of its pixel sample (already past the camera's dimensions).
 pub struct CameraSample {
@@ -24,7 +25,14 @@ pub struct CameraSample {
 /// The radiance of every sample's path: `out[i]` is `path::li` of `samples[i]`, bit for bit.
 ///
 /// Panics if the slices differ in length.
-pub fn li_batch(s: &PathSettings, scene: &World, samples: &mut [CameraSample], out: &mut [Rgb], c: &mut Counters) {
+pub fn li_batch(
+    s: &PathSettings,
+    scene: &World,
+    traversal: BatchTraversal,
+    samples: &mut [CameraSample],
+    out: &mut [Rgb],
+    c: &mut Counters,
+) {
     assert_eq!(samples.len(), out.len(), "li_batch: one radiance per sample");
     let mut paths: Vec<PathState> = samples.iter().map(|cs| PathState::new(s, &cs.ray)).collect();
     let mut live: Vec<usize> = (0..paths.len()).filter(|&i| paths[i].tracing).collect();
@@ -39,7 +47,7 @@ pub fn li_batch(s: &PathSettings, scene: &World, samples: &mut [CameraSample], o
         rays.extend(live.iter().map(|&i| &paths[i]).filter(|p| !p.traces_hidden_emitters(s)).map(|p| p.ray));
         hits.clear();
         hits.resize(rays.len(), None);
-        scene.intersect_batch(&rays, &mut hits);
+        scene.intersect_many(&rays, &mut hits, traversal);
         c.rays += rays.len() as u64;
 
         // Paths step grouped by the instance they hit, so that consecutive steps run the same
@@ -69,7 +77,7 @@ pub fn li_batch(s: &PathSettings, scene: &World, samples: &mut [CameraSample], o
         }
         blocked.clear();
         blocked.resize(rays.len(), false);
-        scene.occluded_batch(&rays, &mut blocked);
+        scene.occluded_many(&rays, &mut blocked, traversal);
         for (&i, &b) in shadowed.iter().zip(&blocked) {
             let path = &mut paths[i];
             if let Some(q) = path.shadow.take() {

@@ -19,7 +19,7 @@ pub use passes::{relative_error, render_passes, Adaptive, PassOutcome, PassReque
 use crate::integrators::Integrator;
 use crate::io::Image;
 use crate::sampling::SamplerKind;
-use crate::world::World;
+use crate::world::{BatchTraversal, World};
 use std::sync::atomic::AtomicBool;
 
 #[derive(Clone, Debug)]
@@ -36,18 +36,32 @@ pub struct RenderSettings {
 }
 
 /// How a thread schedules its camera samples' paths. The integrators' answers are the same
-/// bits under both, so this trades only speed (BENCHMARKS.md, "Many paths in flight").
+/// bits under every schedule, so this trades only speed (BENCHMARKS.md, "Many paths in flight").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Schedule {
     /// Each path traced to its end before the next starts (the reference the tests compare
-    /// the wavefront against).
+    /// the others against).
     OnePath,
-    /// Up to [`WAVEFRONT_PATHS`] paths of a tile advanced together, their rays traced in
-    /// batches (only the path tracer batches; other integrators run one path at a time).
-    /// The default: 1.00-1.12x the one-path schedule's speed (BENCHMARKS.md).
+    /// Up to [`WAVEFRONT_PATHS`] paths of a tile advanced together, a bounce at a time, each
+    /// batch of rays traced through the single-ray kernels (only the path tracer batches;
+    /// other integrators run one path at a time). The default: the fastest measured.
     #[default]
     Wavefront,
+    /// As `Wavefront`, the batches traced by the interleaved batch traversal (several rays in
+    /// flight per thread): 3-4% slower than `Wavefront` on Zen 5 (BENCHMARKS.md).
+    WavefrontInterleaved,
+}
+
+impl Schedule {
+    /// How the wavefront schedules trace their batches (`None`: one path at a time).
+    pub fn batch_traversal(self) -> Option<BatchTraversal> {
+        match self {
+            Schedule::OnePath => None,
+            Schedule::Wavefront => Some(BatchTraversal::OneByOne),
+            Schedule::WavefrontInterleaved => Some(BatchTraversal::Interleaved),
+        }
+    }
 }
 
 impl std::str::FromStr for Schedule {
@@ -56,7 +70,8 @@ impl std::str::FromStr for Schedule {
         match s {
             "one-path" => Ok(Schedule::OnePath),
             "wavefront" => Ok(Schedule::Wavefront),
-            _ => Err(format!("unknown schedule '{s}' (expected one-path or wavefront)")),
+            "wavefront-interleaved" => Ok(Schedule::WavefrontInterleaved),
+            _ => Err(format!("unknown schedule '{s}' (expected wavefront, wavefront-interleaved or one-path)")),
         }
     }
 }

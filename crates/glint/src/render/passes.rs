@@ -4,11 +4,11 @@
 
 use super::film::{to_fixed, Block, Film, PixelSums, Rect};
 use super::splat::{splat_margin, SplatBuffer};
-use super::{Aov, Progress, RenderSettings, RenderStats, Schedule, WAVEFRONT_PATHS};
+use super::{Aov, Progress, RenderSettings, RenderStats, WAVEFRONT_PATHS};
 use crate::integrators::{closest_hit_cost, first_hit, CameraSample, Counters, Integrator};
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
-use crate::world::World;
+use crate::world::{BatchTraversal, World};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -219,14 +219,14 @@ impl PassJob<'_> {
                     }
                     for s in self.samples.clone() {
                         let (origin, camera) = self.camera_sample(x, y, s);
-                        match self.settings.schedule {
-                            Schedule::OnePath => {
+                        match self.settings.schedule.batch_traversal() {
+                            None => {
                                 let mut cs = camera;
                                 let l = self.integrator.li(self.scene, &cs.ray, &mut cs.sampler, &mut counts.counters);
                                 let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];
                                 self.record(&origin, &cs.ray, l, &mut pixels[i], aov, band_splat.as_mut(), &mut counts);
                             }
-                            Schedule::Wavefront => {
+                            Some(_) => {
                                 wave.origins.push(SampleOrigin { index: i, ..origin });
                                 wave.cameras.push(camera);
                                 if wave.cameras.len() >= WAVEFRONT_PATHS {
@@ -270,9 +270,13 @@ impl PassJob<'_> {
         mut splat: Option<&mut SplatBuffer>,
         counts: &mut TileCounts,
     ) {
+        if wave.cameras.is_empty() {
+            return;
+        }
+        let traversal = self.settings.schedule.batch_traversal().unwrap_or(BatchTraversal::OneByOne);
         wave.radiance.clear();
         wave.radiance.resize(wave.cameras.len(), Rgb::BLACK);
-        self.integrator.li_batch(self.scene, &mut wave.cameras, &mut wave.radiance, &mut counts.counters);
+        self.integrator.li_batch(self.scene, traversal, &mut wave.cameras, &mut wave.radiance, &mut counts.counters);
         for ((origin, camera), &l) in wave.origins.iter().zip(&wave.cameras).zip(&wave.radiance) {
             let i = origin.index;
             let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];

@@ -39,6 +39,15 @@ pub struct Instance {
     pub media: MediumBoundary,
 }
 
+/// How a batch of rays is traced: the answers are the same bits either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BatchTraversal {
+    /// Each ray through the single-ray kernels, one after another.
+    OneByOne,
+    /// Several traversals in flight per thread, interleaved ([`World::intersect_batch`]).
+    Interleaved,
+}
+
 /// What traversal returns: enough to find the hit again, nothing more.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
@@ -210,6 +219,32 @@ impl World {
             } else {
                 best
             };
+        }
+    }
+
+    /// Closest hits of many rays traced as `traversal` says (same answers either way).
+    pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>], traversal: BatchTraversal) {
+        match traversal {
+            BatchTraversal::Interleaved => self.intersect_batch(rays, hits),
+            BatchTraversal::OneByOne => {
+                assert_eq!(rays.len(), hits.len(), "intersect_many: one hit slot per ray");
+                for (r, h) in rays.iter().zip(hits.iter_mut()) {
+                    *h = self.intersect(r);
+                }
+            }
+        }
+    }
+
+    /// Occlusion of many rays traced as `traversal` says (same answers either way).
+    pub fn occluded_many(&self, rays: &[Ray], blocked: &mut [bool], traversal: BatchTraversal) {
+        match traversal {
+            BatchTraversal::Interleaved => self.occluded_batch(rays, blocked),
+            BatchTraversal::OneByOne => {
+                assert_eq!(rays.len(), blocked.len(), "occluded_many: one answer per ray");
+                for (r, b) in rays.iter().zip(blocked.iter_mut()) {
+                    *b = self.occluded(r);
+                }
+            }
         }
     }
 

@@ -39,14 +39,15 @@ pub fn path(strategy: Strategy) -> Integrator {
     Integrator::Path(PathSettings { strategy, ..PathSettings::default() })
 }
 
-/// Renders with both path schedules, checks that they give the same bits, and returns the
-/// image: so every validation test that renders through here holds for both.
+/// Renders with every path schedule, checks that they give the same bits, and returns the
+/// image: so every validation test that renders through here holds for all of them.
 pub fn render_with(scene: &World, integrator: &Integrator, spp: u32, seed: u64) -> RenderOutput {
     let out = render(scene, integrator, &settings(spp, seed), &Silent);
     assert_eq!(out.stats.discarded_samples, 0, "the renderer produced NaN, infinite or negative samples");
-    let wave =
-        render(scene, integrator, &RenderSettings { schedule: Schedule::Wavefront, ..settings(spp, seed) }, &Silent);
-    assert_same_bits(&out, &wave);
+    for schedule in [Schedule::Wavefront, Schedule::WavefrontInterleaved] {
+        let other = render(scene, integrator, &RenderSettings { schedule, ..settings(spp, seed) }, &Silent);
+        assert_same_bits(&out, &other);
+    }
     out
 }
 
