@@ -32,6 +32,18 @@ pub struct Rectangle {
     pub ex: Vec3,
     pub ey: Vec3,
     pub normal: Vec3,
+    /// The edges' unit vectors and lengths in f64, worked out once: every shading point
+    /// needs them to decide how to sample.
+    edges: EdgeFrame,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct EdgeFrame {
+    x: V,
+    y: V,
+    z: V,
+    lx: f64,
+    ly: f64,
 }
 
 impl Rectangle {
@@ -59,7 +71,16 @@ impl Rectangle {
         if n1.dot(n2) <= 0.0 {
             return None;
         }
-        Some(Rectangle { corner: lone1, ex, ey, normal: n1.normalize() })
+        Some(Rectangle::new(lone1, ex, ey, n1.normalize()))
+    }
+
+    /// The rectangle `corner + s ex + t ey` (s, t in [0, 1]) facing `normal`; `ex` and `ey`
+    /// must be perpendicular.
+    pub fn new(corner: Vec3, ex: Vec3, ey: Vec3, normal: Vec3) -> Rectangle {
+        let (wx, wy) = (wide(ex), wide(ey));
+        let (x, y) = (unit(wx), unit(wy));
+        let edges = EdgeFrame { x, y, z: cross(x, y), lx: dot(wx, wx).sqrt(), ly: dot(wy, wy).sqrt() };
+        Rectangle { corner, ex, ey, normal, edges }
     }
 
     pub fn area(&self) -> f32 {
@@ -108,11 +129,7 @@ impl SphericalRectangle {
     /// [`SphericalRectangle::new`] with the area-density spread below which area sampling is
     /// kept as a parameter (tests of the parametrization pass 0: always by solid angle).
     fn with_min_spread(r: &Rectangle, p: Vec3, min_spread: f64) -> Option<SphericalRectangle> {
-        let (ex, ey) = (wide(r.ex), wide(r.ey));
-        let (lx, ly) = (dot(ex, ex).sqrt(), dot(ey, ey).sqrt());
-        let x = unit(ex);
-        let y = unit(ey);
-        let mut z = cross(x, y);
+        let EdgeFrame { x, y, mut z, lx, ly } = r.edges;
         let origin = wide(p);
         let c = wide(r.corner);
         let d = [c[0] - origin[0], c[1] - origin[1], c[2] - origin[2]];
@@ -199,12 +216,7 @@ mod tests {
     use super::*;
 
     fn rect() -> Rectangle {
-        Rectangle {
-            corner: vec3(-0.5, 1.0, -0.3),
-            ex: vec3(1.0, 0.0, 0.0),
-            ey: vec3(0.0, 0.2, 0.6),
-            normal: Vec3::ZERO,
-        }
+        Rectangle::new(vec3(-0.5, 1.0, -0.3), vec3(1.0, 0.0, 0.0), vec3(0.0, 0.2, 0.6), Vec3::ZERO)
     }
 
     #[test]

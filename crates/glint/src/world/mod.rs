@@ -265,6 +265,9 @@ impl World {
     /// whose distance `r.t_max` already is) when none is nearer.
     #[inline]
     fn intersect_unflattened(&self, r: &mut Ray, mut best: Option<Hit>) -> Option<Hit> {
+        if !self.top.has_unflattened() {
+            return best; // not even the ray set-up of an empty traversal
+        }
         self.top.traverse(r, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
             if let Some(h) = self.intersect_instance(inst, r) {
@@ -310,6 +313,9 @@ impl World {
     /// Whether an instance outside the flat BVH blocks the ray.
     #[inline]
     fn occluded_unflattened(&self, ray: &Ray) -> bool {
+        if !self.top.has_unflattened() {
+            return false;
+        }
         self.top.occluded(ray, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
             match inst.shape {
