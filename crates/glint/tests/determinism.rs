@@ -7,24 +7,15 @@
 
 mod common;
 
-use common::scenes::{cornell_box_with, path, rough_mirror};
+use common::scenes::{add_glass_and_metal_balls, cornell_box_with, path};
 use glint::integrators::{Integrator, Strategy, WhittedSettings};
-use glint::materials::{Material, MaterialKind};
-use glint::math::{vec3, Rgb, Transform};
 use glint::render::{render, RenderOutput, RenderSettings, Silent};
 use glint::world::World;
 
 fn scene() -> World {
     // 30×22: tiles of most sizes leave partial tiles at the right and bottom.
     cornell_box_with(30, 22, |b| {
-        let glass = b.add_material(Material::new(
-            "glass",
-            MaterialKind::Dielectric { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
-            false,
-        ));
-        let metal = rough_mirror(b, "metal", 0.2);
-        b.add_sphere(vec3(-0.4, 1.6, 0.4), 0.25, &Transform::IDENTITY, glass, None, false).unwrap();
-        b.add_sphere(vec3(0.5, 1.3, -0.4), 0.2, &Transform::IDENTITY, metal, None, false).unwrap();
+        add_glass_and_metal_balls(b);
     })
 }
 

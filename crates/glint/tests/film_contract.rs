@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::scenes::{add_quad, camera, cornell_box_with, diffuse, path, rough_mirror};
+use common::scenes::{add_glass_and_metal_balls, add_quad, camera, cornell_box_with, diffuse, path};
 use glint::accel::BvhSplit;
 use glint::build::WorldBuilder;
 use glint::integrators::{Integrator, Strategy, WhittedSettings};
@@ -27,14 +27,7 @@ const SPP: u32 = 8; // three passes, the last one short
 
 fn contract_scene() -> World {
     cornell_box_with(W, H, |b| {
-        let glass = b.add_material(Material::new(
-            "glass",
-            MaterialKind::Dielectric { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
-            false,
-        ));
-        let metal = rough_mirror(b, "metal", 0.2);
-        b.add_sphere(vec3(-0.4, 1.6, 0.4), 0.25, &Transform::IDENTITY, glass, None, false).unwrap();
-        b.add_sphere(vec3(0.5, 1.3, -0.4), 0.2, &Transform::IDENTITY, metal, None, false).unwrap();
+        add_glass_and_metal_balls(b);
     })
 }
 

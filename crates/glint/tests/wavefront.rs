@@ -14,10 +14,9 @@
 mod common;
 
 use common::load::load;
-use common::scenes::{add_box, assert_same_bits, cornell_box_with, rough_mirror};
+use common::scenes::{add_box, add_glass_and_metal_balls, assert_same_bits, cornell_box_with};
 use glint::integrators::{Integrator, PathSettings, Strategy};
-use glint::materials::{Material, MaterialKind};
-use glint::math::{vec3, Ray, Rgb, Transform, Vec3};
+use glint::math::{vec3, Ray, Transform, Vec3};
 use glint::render::{render, RenderOutput, RenderSettings, Schedule, Silent};
 use glint::world::{Hit, World};
 use proptest::prelude::*;
@@ -30,14 +29,7 @@ fn scene() -> &'static World {
     static SCENE: OnceLock<World> = OnceLock::new();
     SCENE.get_or_init(|| {
         cornell_box_with(30, 22, |b| {
-            let glass = b.add_material(Material::new(
-                "glass",
-                MaterialKind::Dielectric { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
-                false,
-            ));
-            let metal = rough_mirror(b, "metal", 0.2);
-            b.add_sphere(vec3(-0.4, 1.6, 0.4), 0.25, &Transform::IDENTITY, glass, None, false).unwrap();
-            b.add_sphere(vec3(0.5, 1.3, -0.4), 0.2, &Transform::IDENTITY, metal, None, false).unwrap();
+            let (glass, metal) = add_glass_and_metal_balls(b);
             let xf = Transform::translate(vec3(0.0, 1.2, 0.2)).then_after(&Transform::rotate(Vec3::Y, 30.0));
             let cube = std::sync::Arc::new(glint::geometry::cube_mesh(glint::accel::BvhSplit::Sah));
             b.add_mesh_instance(

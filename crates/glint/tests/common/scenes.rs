@@ -163,3 +163,17 @@ pub fn cornell_box_with(width: u32, height: u32, extra: impl FnOnce(&mut WorldBu
     let cam = camera(vec3(0.0, 1.0, 3.9), vec3(0.0, 1.0, 0.0), Vec3::Y, 39.0, width, height);
     b.finish(cam, LightSelection::Power).unwrap()
 }
+
+/// The glass ball and the glossy metal ball the scheduling tests add to the Cornell box
+/// (paths there branch, refract and end by Russian roulette); returns (glass, metal).
+pub fn add_glass_and_metal_balls(b: &mut WorldBuilder) -> (u32, u32) {
+    let glass = b.add_material(Material::new(
+        "glass",
+        MaterialKind::Dielectric { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+        false,
+    ));
+    let metal = rough_mirror(b, "metal", 0.2);
+    b.add_sphere(vec3(-0.4, 1.6, 0.4), 0.25, &Transform::IDENTITY, glass, None, false).unwrap();
+    b.add_sphere(vec3(0.5, 1.3, -0.4), 0.2, &Transform::IDENTITY, metal, None, false).unwrap();
+    (glass, metal)
+}
