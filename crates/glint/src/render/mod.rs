@@ -49,7 +49,7 @@ pub enum Schedule {
     #[default]
     Wavefront,
     /// As `Wavefront`, the batches traced by the interleaved batch traversal (several rays in
-    /// flight per thread): 3-4% slower than `Wavefront` on Zen 5 (BENCHMARKS.md).
+    /// flight per thread): 3 to 5% slower than `Wavefront` on Zen 5 (BENCHMARKS.md).
     WavefrontInterleaved,
 }
 

@@ -336,7 +336,7 @@ struct SampleOrigin {
     py: f32,
 }
 
-/// Camera samples queued for [`Schedule::Wavefront`], and room for their radiance.
+/// Camera samples queued for the wavefront schedules, and room for their radiance.
 #[derive(Default)]
 struct Wave {
     origins: Vec<SampleOrigin>,
