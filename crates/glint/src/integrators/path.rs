@@ -12,15 +12,16 @@
 use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
+use crate::math::{Ray, Rgb, Vec3};
+use crate::sampling::{power_heuristic, Sampler};
+use crate::world::{Hit, World};
 
 /// The longest path, in segments, even when `max_depth` is unbounded: a hard ceiling so that
 /// a path trapped between mirrors with a Russian roulette probability of 1 still ends. Light
 /// carried by longer paths is lost (a bias below throughput^4096).
 pub const MAX_PATH_DEPTH: u32 = 4096;
-use crate::math::{Ray, Rgb, Vec3};
-use crate::sampling::{power_heuristic, Sampler};
-use crate::world::{Hit, World};
 
+/// The radiance along `camera_ray`, its path traced to its end one ray at a time.
 pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
     let mut path = PathState::new(s, camera_ray);
     while path.tracing {
