@@ -31,7 +31,7 @@ pub struct RenderSettings {
     /// Also return the per-pixel variance of the mean (for statistical tests).
     pub variance: bool,
     pub tile_size: usize,
-    /// How paths are scheduled; the image is the same bits either way.
+    /// How paths are scheduled; the image is the same bits under every schedule.
     pub schedule: Schedule,
 }
 
