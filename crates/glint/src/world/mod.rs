@@ -209,16 +209,11 @@ impl World {
         assert_eq!(rays.len(), hits.len(), "intersect_batch: one hit slot per ray");
         let mut flat = vec![None; rays.len()];
         self.top.intersect_flat_batch(rays, &mut flat);
-        let rest = self.top.has_unflattened();
         for ((ray, f), out) in rays.iter().zip(flat).zip(hits.iter_mut()) {
             let best = f.map(|(instance, prim, h)| Hit { t: h.t, instance, prim, b1: h.b1, b2: h.b2 });
-            *out = if rest {
-                // As the single-ray flat traversal leaves it: shortened to the hit.
-                let mut r = Ray { t_max: best.map_or(ray.t_max, |h| h.t), ..*ray };
-                self.intersect_unflattened(&mut r, best)
-            } else {
-                best
-            };
+            // As the single-ray flat traversal leaves it: shortened to the hit.
+            let mut r = Ray { t_max: best.map_or(ray.t_max, |h| h.t), ..*ray };
+            *out = self.intersect_unflattened(&mut r, best);
         }
     }
 
@@ -254,10 +249,8 @@ impl World {
     pub fn occluded_batch(&self, rays: &[Ray], blocked: &mut [bool]) {
         assert_eq!(rays.len(), blocked.len(), "occluded_batch: one answer per ray");
         self.top.occluded_flat_batch(rays, blocked);
-        if self.top.has_unflattened() {
-            for (ray, b) in rays.iter().zip(blocked.iter_mut()) {
-                *b = *b || self.occluded_unflattened(ray);
-            }
+        for (ray, b) in rays.iter().zip(blocked.iter_mut()) {
+            *b = *b || self.occluded_unflattened(ray);
         }
     }
 
