@@ -4,7 +4,7 @@
 //! closest-hit distance as the binary BVH and as testing every triangle, the same occlusion
 //! answer, and the same hit (triangle and barycentrics) as every other path.
 
-use glint::accel::{BvhSplit, SimdPath};
+use glint::accel::{intersect_triangle, BvhSplit, ShearedRay, SimdPath};
 use glint::geometry::{MeshAccel, TriangleMesh};
 use glint::math::{vec3, Ray};
 use proptest::prelude::*;
@@ -94,6 +94,13 @@ proptest! {
                     let got = mesh.intersect_with(&mut r, path);
                     prop_assert_eq!(got.map(|h| h.1.t), brute.map(|h| h.1.t), "{:?} {} ray {:?}", accel, path, ray);
                     prop_assert_eq!(mesh.occluded_with(&ray, path), brute.is_some(), "{:?} {} ray {:?}", accel, path, ray);
+                    // The triangle reported is one the ray meets at that distance, with those
+                    // barycentrics (blocks tested in pairs must map lanes back to triangles).
+                    if let Some((prim, hit)) = got {
+                        let [p0, p1, p2] = mesh.vertices(prim as usize);
+                        let alone = intersect_triangle(&ray, &ShearedRay::new(ray.dir), p0, p1, p2);
+                        prop_assert_eq!(alone, Some(hit), "{:?} {} triangle {}, ray {:?}", accel, path, prim, ray);
+                    }
                     // Identical hits (triangle, t, barycentrics) whatever the path.
                     match first {
                         None => first = Some(got),

@@ -56,16 +56,22 @@ impl TriRay {
     }
 }
 
-/// Results of a four-triangle test: lanes hit within the interval, and their t, b1, b2.
+/// Results of a test of N triangle lanes (one block of four, or two blocks side by side):
+/// lanes hit within the interval, and their t, b1, b2.
 #[derive(Clone, Copy, Debug)]
-pub struct Tri4Hits {
+pub struct TriHits<const N: usize> {
     pub mask: u32,
-    pub t: [f32; 4],
-    pub b1: [f32; 4],
-    pub b2: [f32; 4],
+    pub t: [f32; N],
+    pub b1: [f32; N],
+    pub b2: [f32; N],
 }
 
-impl Tri4Hits {
+/// Results of a four-triangle test.
+pub type Tri4Hits = TriHits<4>;
+
+impl<const N: usize> TriHits<N> {
+    pub const NONE: TriHits<N> = TriHits { mask: 0, t: [0.0; N], b1: [0.0; N], b2: [0.0; N] };
+
     /// The nearest lane hit, the first among equals (as testing the lanes in order with a
     /// shrinking interval would find).
     #[inline(always)]
@@ -81,6 +87,19 @@ impl Tri4Hits {
         }
         best
     }
+}
+
+/// Two blocks' results side by side: `lo`'s lanes first, as one test of both would give.
+#[inline(always)]
+pub fn join_hits(lo: &Tri4Hits, hi: &Tri4Hits) -> TriHits<8> {
+    let mut h = TriHits::<8> { mask: lo.mask | (hi.mask << 4), ..TriHits::NONE };
+    h.t[..4].copy_from_slice(&lo.t);
+    h.t[4..].copy_from_slice(&hi.t);
+    h.b1[..4].copy_from_slice(&lo.b1);
+    h.b1[4..].copy_from_slice(&hi.b1);
+    h.b2[..4].copy_from_slice(&lo.b2);
+    h.b2[4..].copy_from_slice(&hi.b2);
+    h
 }
 
 /// One lane of the watertight test, in exactly the operations of `intersect_triangle`:
@@ -126,10 +145,23 @@ pub fn tri_lane(b: &Tri4, lane: usize, r: &TriRay, t_min: f32, t_max: f32) -> Op
     Some((t, v * inv, w * inv))
 }
 
+/// Whether lane `lane` has an edge function that is exactly zero in single precision (the
+/// case `tri_lane` redoes in double precision); for tests of the SIMD paths' fallback.
+#[cfg(test)]
+pub fn tri_lane_has_zero_edge(b: &Tri4, lane: usize, r: &TriRay) -> bool {
+    let [kx, ky, kz] = r.k;
+    let rel = |k: usize, axis: usize| b.v[k][axis][lane] - r.o[axis];
+    let [sx, sy, _] = r.s;
+    let (ax, ay) = (rel(0, kx) - sx * rel(0, kz), rel(0, ky) - sy * rel(0, kz));
+    let (bx, by) = (rel(1, kx) - sx * rel(1, kz), rel(1, ky) - sy * rel(1, kz));
+    let (cx, cy) = (rel(2, kx) - sx * rel(2, kz), rel(2, ky) - sy * rel(2, kz));
+    cx * by - cy * bx == 0.0 || ax * cy - ay * cx == 0.0 || bx * ay - by * ax == 0.0
+}
+
 /// All four lanes through [`tri_lane`].
 #[inline(always)]
 pub fn tri4_scalar(b: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> Tri4Hits {
-    let mut h = Tri4Hits { mask: 0, t: [0.0; 4], b1: [0.0; 4], b2: [0.0; 4] };
+    let mut h = Tri4Hits::NONE;
     for lane in 0..4 {
         if let Some((t, b1, b2)) = tri_lane(b, lane, r, t_min, t_max) {
             h.mask |= 1 << lane;

@@ -19,7 +19,7 @@ pub use scalar::Scalar;
 #[cfg(target_arch = "x86_64")]
 pub use sse::Sse;
 
-use super::tri4::{Tri4, Tri4Hits, TriRay};
+use super::tri4::{join_hits, Tri4, Tri4Hits, TriHits, TriRay};
 use super::wide::{NodeRay, WideNode};
 use std::sync::atomic::{AtomicU8, Ordering};
 
@@ -128,4 +128,81 @@ pub unsafe trait Isa {
     /// # Safety
     /// As for [`Isa::node`]; `r.k` must hold axes below 3, which `TriRay::new` ensures.
     unsafe fn tri4(block: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> Tri4Hits;
+    /// Two blocks in one test: lanes 0..4 are `lo`'s, 4..8 `hi`'s, each exactly as
+    /// [`Isa::tri4`] finds it. Paths with eight lanes per instruction do both at once.
+    ///
+    /// # Safety
+    /// As for [`Isa::tri4`].
+    #[inline(always)]
+    unsafe fn tri8(lo: &Tri4, hi: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> TriHits<8> {
+        join_hits(&Self::tri4(lo, r, t_min, t_max), &Self::tri4(hi, r, t_min, t_max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::tri4::tri4_scalar;
+    use crate::math::{vec3, Ray, Vec3};
+    use crate::sampling::Rng;
+
+    /// `S::tri8` on two blocks against the scalar test of each: the same lanes hit, with the
+    /// same t and barycentrics, bit for bit.
+    fn check_tri8<S: Isa>(path: SimdPath) {
+        assert!(path.is_available());
+        let mut rng = Rng::new(5, 8);
+        // Vertices on a coarse grid, so that rays aimed at grid points often pass exactly
+        // through vertices and edges (zero edge functions: the double-precision fallback).
+        let mut grid = |rng: &mut Rng| (rng.next_u32() % 5) as f32 - 2.0;
+        let mut point = |rng: &mut Rng| vec3(grid(rng), grid(rng), grid(rng));
+        let mut block = |rng: &mut Rng| {
+            let n = 1 + (rng.next_u32() % 4) as usize;
+            let tris: Vec<(u32, [Vec3; 3])> =
+                (0..n).map(|i| (rng.next_u32() % 1000 + i as u32, [point(rng), point(rng), point(rng)])).collect();
+            Tri4::pack(&tris)
+        };
+        let (mut hits, mut fallbacks) = (0, 0);
+        for i in 0..20_000 {
+            let (lo, hi) = (block(&mut rng), block(&mut rng));
+            let origin = vec3(grid(&mut rng) * 1.5, grid(&mut rng) * 1.5, 4.0 + grid(&mut rng));
+            let target = match i % 3 {
+                0 => lo.vertex((i / 3) % 3, 0),
+                1 => (hi.vertex(0, 1) + hi.vertex(1, 1)) * 0.5,
+                _ => vec3(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0),
+            };
+            let mut ray = Ray::new(origin, target - origin);
+            if i % 7 == 0 {
+                ray.t_max = rng.next_f32() * 2.0;
+            }
+            let r = TriRay::new(&ray);
+            let want =
+                join_hits(&tri4_scalar(&lo, &r, ray.t_min, ray.t_max), &tri4_scalar(&hi, &r, ray.t_min, ray.t_max));
+            // SAFETY: the path is available (asserted above).
+            let got = unsafe { S::tri8(&lo, &hi, &r, ray.t_min, ray.t_max) };
+            assert_eq!(got.mask, want.mask, "{path}: lanes hit, ray {ray:?}");
+            for lane in (0..8).filter(|l| want.mask >> l & 1 == 1) {
+                let bits = |h: &TriHits<8>| [h.t[lane].to_bits(), h.b1[lane].to_bits(), h.b2[lane].to_bits()];
+                assert_eq!(bits(&got), bits(&want), "{path}: lane {lane}, ray {ray:?}");
+            }
+            hits += want.mask.count_ones();
+            fallbacks += (0..2).any(|b| {
+                let blk = if b == 0 { &lo } else { &hi };
+                (0..4).any(|l| crate::accel::tri4::tri_lane_has_zero_edge(blk, l, &r))
+            }) as u32;
+        }
+        // The cases that matter were exercised: hits, and zero edge functions.
+        assert!(hits > 1000 && fallbacks > 100, "{path}: {hits} hits, {fallbacks} pairs with a zero edge");
+    }
+
+    #[test]
+    fn tri8_is_two_tri4_tests_on_every_path() {
+        check_tri8::<Scalar>(SimdPath::Scalar);
+        #[cfg(target_arch = "x86_64")]
+        {
+            check_tri8::<Sse>(SimdPath::Sse);
+            if SimdPath::Avx2.is_available() {
+                check_tri8::<Avx2>(SimdPath::Avx2);
+            }
+        }
+    }
 }

@@ -67,7 +67,7 @@ pub(super) unsafe fn tri4_sse(b: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> T
     let zero_bits = _mm_movemask_ps(any_zero);
     if zero_bits | _mm_movemask_ps(inside) == 0 {
         // Most blocks: the ray passes outside every triangle.
-        return Tri4Hits { mask: 0, t: [0.0; 4], b1: [0.0; 4], b2: [0.0; 4] };
+        return Tri4Hits::NONE;
     }
     if zero_bits != 0 {
         // An edge function is exactly zero (ray through an edge or vertex): the reference
@@ -83,7 +83,7 @@ pub(super) unsafe fn tri4_sse(b: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> T
     let inv = _mm_div_ps(_mm_set1_ps(1.0), det);
     let t = _mm_mul_ps(t_scaled, inv);
     ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(t, _mm_set1_ps(t_min)), _mm_cmplt_ps(t, _mm_set1_ps(t_max))));
-    let mut h = Tri4Hits { mask: _mm_movemask_ps(ok) as u32, t: [0.0; 4], b1: [0.0; 4], b2: [0.0; 4] };
+    let mut h = Tri4Hits { mask: _mm_movemask_ps(ok) as u32, ..Tri4Hits::NONE };
     if h.mask != 0 {
         _mm_storeu_ps(h.t.as_mut_ptr(), t);
         _mm_storeu_ps(h.b1.as_mut_ptr(), _mm_mul_ps(v, inv));
