@@ -44,6 +44,12 @@ struct EdgeFrame {
     z: V,
     lx: f64,
     ly: f64,
+    /// The same rounded to f32, for the quick test of `area_sampling_is_clearly_uniform`.
+    x32: Vec3,
+    y32: Vec3,
+    z32: Vec3,
+    lx32: f32,
+    ly32: f32,
 }
 
 impl Rectangle {
@@ -79,7 +85,10 @@ impl Rectangle {
     pub fn new(corner: Vec3, ex: Vec3, ey: Vec3, normal: Vec3) -> Rectangle {
         let (wx, wy) = (wide(ex), wide(ey));
         let (x, y) = (unit(wx), unit(wy));
-        let edges = EdgeFrame { x, y, z: cross(x, y), lx: dot(wx, wx).sqrt(), ly: dot(wy, wy).sqrt() };
+        let (z, lx, ly) = (cross(x, y), dot(wx, wx).sqrt(), dot(wy, wy).sqrt());
+        let narrow = |v: V| vec3(v[0] as f32, v[1] as f32, v[2] as f32);
+        let (x32, y32, z32) = (narrow(x), narrow(y), narrow(z));
+        let edges = EdgeFrame { x, y, z, lx, ly, x32, y32, z32, lx32: lx as f32, ly32: ly as f32 };
         Rectangle { corner, ex, ey, normal, edges }
     }
 
@@ -102,6 +111,28 @@ fn unit(a: V) -> V {
 }
 fn wide(v: Vec3) -> V {
     [v.x as f64, v.y as f64, v.z as f64]
+}
+
+/// The spread test of [`SphericalRectangle::new`] in f32, with a margin: true only where the
+/// f64 test also finds area sampling's density varying by less than `min_spread` (so the
+/// decision, and the image, are the same), at a third of the cost. Most shading points are
+/// far from the light compared with its size and end here.
+///
+/// Why the margin is safe: where this returns true, r = far²/near² < 4 (for the spread of 8;
+/// the same argument holds for any), so near² > far²/4 >= |d|²/4 (far² is at least |d|², d
+/// the corner seen from `p` in the edge frame) and the edges are at most 2 sqrt(far²) long:
+/// every term is within a small factor of |d|², and f32 rounding moves r by well under 1e-4
+/// relative, far inside the 10% margin on r³. NaN fails the comparison: the f64 test decides.
+#[inline]
+fn area_sampling_is_clearly_uniform(r: &Rectangle, p: Vec3, min_spread: f64) -> bool {
+    let e = &r.edges;
+    let d = r.corner - p;
+    let (x0, y0, z0) = (d.dot(e.x32), d.dot(e.y32), d.dot(e.z32));
+    let (x1, y1) = (x0 + e.lx32, y0 + e.ly32);
+    let near2 = x0.max(0.0).min(x1).powi(2) + y0.max(0.0).min(y1).powi(2) + z0 * z0;
+    let far2 = x0.abs().max(x1.abs()).powi(2) + y0.abs().max(y1.abs()).powi(2) + z0 * z0;
+    let ratio = far2 / near2;
+    ratio * ratio * ratio < (0.9 * min_spread * min_spread) as f32
 }
 
 /// The rectangle as seen from a point: its coordinates in a frame at the point with axes
@@ -129,7 +160,15 @@ impl SphericalRectangle {
     /// [`SphericalRectangle::new`] with the area-density spread below which area sampling is
     /// kept as a parameter (tests of the parametrization pass 0: always by solid angle).
     fn with_min_spread(r: &Rectangle, p: Vec3, min_spread: f64) -> Option<SphericalRectangle> {
-        let EdgeFrame { x, y, mut z, lx, ly } = r.edges;
+        if area_sampling_is_clearly_uniform(r, p, min_spread) {
+            return None;
+        }
+        Self::with_min_spread_f64(r, p, min_spread)
+    }
+
+    /// The decision and set-up in f64 alone (what the f32 test must never contradict).
+    fn with_min_spread_f64(r: &Rectangle, p: Vec3, min_spread: f64) -> Option<SphericalRectangle> {
+        let EdgeFrame { x, y, mut z, lx, ly, .. } = r.edges;
         let origin = wide(p);
         let c = wide(r.corner);
         let d = [c[0] - origin[0], c[1] - origin[1], c[2] - origin[2]];
@@ -227,6 +266,38 @@ mod tests {
             // The corners are summed in f32 for the triangles: agreement to f32 rounding.
             assert!((s.solid_angle() / other - 1.0).abs() < 1e-6, "{p:?}: {} vs {other}", s.solid_angle());
         }
+    }
+
+    #[test]
+    fn quick_f32_test_never_contradicts_the_f64_one() {
+        let mut rng = crate::sampling::Rng::new(3, 9);
+        let mut f = |scale: f32| (rng.next_f32() * 2.0 - 1.0) * scale;
+        let (mut f64_rejects, mut caught) = (0, 0);
+        for i in 0..200_000 {
+            // Rectangles of all sizes and orientations, points near and far, some on the plane.
+            let size = [0.01, 1.0, 300.0][i % 3];
+            let ex = vec3(f(size), f(size), f(size));
+            let ey = ex.cross(vec3(f(1.0), f(1.0), f(1.0))).normalize() * (size * (0.1 + f(1.0).abs()));
+            let rect = Rectangle::new(vec3(f(500.0), f(500.0), f(500.0)), ex, ey, ex.cross(ey).normalize());
+            let reach = [0.001, 1.0, 10.0, 1000.0][i % 4] * size;
+            let mut p = rect.corner + ex * f(1.5) + ey * f(1.5) + rect.normal * f(reach);
+            if i % 50 == 0 {
+                p = rect.corner + ex * f(1.0); // in the plane
+            }
+            let quick = area_sampling_is_clearly_uniform(&rect, p, MIN_AREA_PDF_SPREAD);
+            let f64_rejects_spread = SphericalRectangle::with_min_spread_f64(&rect, p, MIN_AREA_PDF_SPREAD).is_none()
+                && SphericalRectangle::with_min_spread_f64(&rect, p, 0.0).is_some();
+            if quick {
+                assert!(
+                    SphericalRectangle::with_min_spread_f64(&rect, p, MIN_AREA_PDF_SPREAD).is_none(),
+                    "f32 test says uniform, f64 samples by solid angle: {rect:?} from {p:?}"
+                );
+            }
+            f64_rejects += f64_rejects_spread as u32;
+            caught += (f64_rejects_spread && quick) as u32;
+        }
+        // It must also be worth having: most points the spread test sends to area sampling.
+        assert!(f64_rejects > 10_000 && caught as f64 > 0.9 * f64_rejects as f64, "{caught} of {f64_rejects}");
     }
 
     #[test]

@@ -153,9 +153,9 @@ mod tests {
         let mut rng = Rng::new(5, 8);
         // Vertices on a coarse grid, so that rays aimed at grid points often pass exactly
         // through vertices and edges (zero edge functions: the double-precision fallback).
-        let mut grid = |rng: &mut Rng| (rng.next_u32() % 5) as f32 - 2.0;
-        let mut point = |rng: &mut Rng| vec3(grid(rng), grid(rng), grid(rng));
-        let mut block = |rng: &mut Rng| {
+        let grid = |rng: &mut Rng| (rng.next_u32() % 5) as f32 - 2.0;
+        let point = |rng: &mut Rng| vec3(grid(rng), grid(rng), grid(rng));
+        let block = |rng: &mut Rng| {
             let n = 1 + (rng.next_u32() % 4) as usize;
             let tris: Vec<(u32, [Vec3; 3])> =
                 (0..n).map(|i| (rng.next_u32() % 1000 + i as u32, [point(rng), point(rng), point(rng)])).collect();
