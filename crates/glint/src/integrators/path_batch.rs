@@ -34,6 +34,8 @@ pub fn li_batch(
     c: &mut Counters,
 ) {
     assert_eq!(samples.len(), out.len(), "li_batch: one radiance per sample");
+    // Positions go in the low 32 bits of the grouping keys.
+    assert!(samples.len() <= u32::MAX as usize, "li_batch: at most 2^32 - 1 samples at once");
     let mut paths: Vec<PathState> = samples.iter().map(|cs| PathState::new(s, &cs.ray)).collect();
     let mut live: Vec<usize> = (0..paths.len()).filter(|&i| paths[i].tracing).collect();
     let mut rays: Vec<Ray> = Vec::with_capacity(live.len());
@@ -62,8 +64,9 @@ pub fn li_batch(
             } else {
                 *batched.next().expect("one batched hit per path traced in the batch")
             };
-            // The instance hit (misses last) above the position: sorting plain integers is
-            // about half the work of sorting the steps by a key (callgrind).
+            // The instance hit (misses last) above the position: sorting plain integers costs
+            // less than sorting the steps by a key (callgrind, Cornell box: 3.9 M instructions
+            // against 5.0 M).
             order.push((hit.map_or(u32::MAX, |h| h.instance) as u64) << 32 | stepping.len() as u64);
             stepping.push(Stepping { path: i, hit });
         }
