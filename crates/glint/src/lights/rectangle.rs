@@ -115,11 +115,12 @@ fn wide(v: Vec3) -> V {
 
 /// The spread test of [`SphericalRectangle::new`] in f32, with a margin: true only where the
 /// f64 test also finds area sampling's density varying by less than `min_spread` (so the
-/// decision, and the image, are the same), at a third of the cost. Most shading points are
-/// far from the light compared with its size and end here.
+/// decision, and the image, are the same), without the conversions and f64 arithmetic. Most
+/// shading points are far from the light compared with its size and end here (on the Cornell
+/// box, `SphericalRectangle::new` went from 8.4 to 6.6 M instructions in callgrind).
 ///
 /// Why the margin is safe: where this returns true, r = far²/near² < 4 (for the spread of 8;
-/// the same argument holds for any), so near² > far²/4 >= |d|²/4 (far² is at least |d|², d
+/// the same argument holds for any moderate spread), so near² > far²/4 >= |d|²/4 (far² is at least |d|², d
 /// the corner seen from `p` in the edge frame) and the edges are at most 2 sqrt(far²) long:
 /// every term is within a small factor of |d|², and f32 rounding moves r by well under 1e-4
 /// relative, far inside the 10% margin on r³. NaN fails the comparison: the f64 test decides.
