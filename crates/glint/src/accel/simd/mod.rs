@@ -1,7 +1,8 @@
 //! Instruction-set paths for the wide BVH kernels, chosen at run time.
 //!
-//! The two kernels that matter, a ray against the W child boxes of a node and a ray against a
-//! block of four triangles, are written once per instruction set behind the [`Isa`] trait.
+//! The kernels that matter, a ray against the W child boxes of a node and a ray against a
+//! block of four triangles (or two blocks at once, where the registers hold eight lanes), are
+//! written once per instruction set behind the [`Isa`] trait.
 //! Traversal is generic over `Isa` and is instantiated inside `#[target_feature]` entry
 //! points (see `wide_mesh.rs`), so the AVX2 path is compiled with AVX2 even though the
 //! binary is built for baseline x86-64. Every path computes exactly the same IEEE operations
