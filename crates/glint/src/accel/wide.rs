@@ -440,15 +440,16 @@ impl<const W: usize> WideBvh<W> {
                 }
                 mask &= !leaf_bits;
                 if mask != 0 {
-                    cur = node.children[mask.trailing_zeros() as usize];
-                    mask &= mask - 1;
-                    while mask != 0 {
-                        // SAFETY: at most W - 1 entries per level of the current path, so
-                        // `sp < depth * (W - 1) + 1 <= STACK`, which `collapse` checked.
-                        unsafe { stack.get_unchecked_mut(sp) }.write(node.children[mask.trailing_zeros() as usize]);
-                        sp += 1;
-                        mask &= mask - 1;
-                    }
+                    // Push every hit child (one compress on AVX-512) and go on with the last;
+                    // in any-hit traversal the order changes the time, never the answer.
+                    // SAFETY: a node at depth d starts with `sp <= (d - 1)(W - 1)` (each level
+                    // of the current path leaves at most W - 1 entries), so the W slots
+                    // written end at index `(d - 1)(W - 1) + W - 1 = d(W - 1) < STACK`, which
+                    // `collapse` checked; `MaybeUninit<u32>` has the layout of `u32`.
+                    let n = unsafe { S::compress_refs(&node.children, mask, stack.as_mut_ptr().add(sp).cast()) };
+                    sp += n - 1;
+                    // SAFETY: `compress_refs` wrote entries `sp - (n - 1)..=sp`.
+                    cur = unsafe { stack.get_unchecked(sp).assume_init() };
                     continue;
                 }
             } else if !nr.t_min.is_nan() {

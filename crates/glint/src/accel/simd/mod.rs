@@ -10,22 +10,26 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 mod scalar;
 #[cfg(target_arch = "x86_64")]
 mod sse;
 
 #[cfg(target_arch = "x86_64")]
 pub use avx2::Avx2;
+#[cfg(target_arch = "x86_64")]
+pub use avx512::Avx512;
 pub use scalar::Scalar;
 #[cfg(target_arch = "x86_64")]
 pub use sse::Sse;
 
-use super::tri4::{join_hits, Tri4, Tri4Hits, TriHits, TriRay};
+use super::tri4::{concat_hits, join_hits, Tri4, Tri4Hits, TriHits, TriRay};
 use super::wide::{NodeRay, WideNode};
 use std::sync::atomic::{AtomicU8, Ordering};
 
-/// Which kernels run. `Avx512` runs the AVX2 kernels compiled with AVX-512 enabled (the
-/// compiler may use its masks and wider register file); the 8-wide node test fits AVX2.
+/// Which kernels run. `Avx512` has kernels of its own where the wider registers and mask
+/// registers pay (see `avx512.rs`) and the AVX2 ones elsewhere, compiled with AVX-512 on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum SimdPath {
     Scalar,
@@ -138,6 +142,39 @@ pub unsafe trait Isa {
     unsafe fn tri8(lo: &Tri4, hi: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> TriHits<8> {
         join_hits(&Self::tri4(lo, r, t_min, t_max), &Self::tri4(hi, r, t_min, t_max))
     }
+
+    /// How many blocks of four the widest test takes at once: 4 where [`Isa::tri16`] is one
+    /// test, else 2. Closest-hit traversal gathers hit leaves' blocks in groups of this size.
+    const BLOCKS_PER_TEST: usize = 2;
+
+    /// Four blocks in one test: lanes `4i..4i + 4` are `blocks[i]`'s, each exactly as
+    /// [`Isa::tri4`] finds it.
+    ///
+    /// # Safety
+    /// As for [`Isa::tri4`].
+    #[inline(always)]
+    unsafe fn tri16(blocks: [&Tri4; 4], r: &TriRay, t_min: f32, t_max: f32) -> TriHits<16> {
+        let [a, b, c, d] = blocks;
+        concat_hits(&[Self::tri8(a, b, r, t_min, t_max), Self::tri8(c, d, r, t_min, t_max)])
+    }
+
+    /// Writes the references `children[i]` for the set bits `i` of `mask` (bits below W),
+    /// lowest first, to `out[0..n]` and returns n, the number of set bits. `out[n..W]` may be
+    /// overwritten with anything (the AVX-512 path stores all W lanes of a compress).
+    ///
+    /// # Safety
+    /// As for [`Isa::node`], and `out` must be valid for writes of W `u32`s.
+    #[inline(always)]
+    unsafe fn compress_refs<const W: usize>(children: &[u32; W], mask: u32, out: *mut u32) -> usize {
+        let (mut n, mut m) = (0, mask & (u32::MAX >> (32 - W)));
+        while m != 0 {
+            // SAFETY: n < W (one write per set bit below W); the caller's contract.
+            unsafe { out.add(n).write(children[m.trailing_zeros() as usize]) };
+            n += 1;
+            m &= m - 1;
+        }
+        n
+    }
 }
 
 #[cfg(test)]
@@ -147,9 +184,9 @@ mod tests {
     use crate::math::{vec3, Ray, Vec3};
     use crate::sampling::Rng;
 
-    /// `S::tri8` on two blocks against the scalar test of each: the same lanes hit, with the
-    /// same t and barycentrics, bit for bit.
-    fn check_tri8<S: Isa>(path: SimdPath) {
+    /// `S::tri8` on two blocks and `S::tri16` on four against the scalar test of each: the
+    /// same lanes hit, with the same t and barycentrics, bit for bit.
+    fn check_grouped_tests<S: Isa>(path: SimdPath) {
         assert!(path.is_available());
         let mut rng = Rng::new(5, 8);
         // Vertices on a coarse grid, so that rays aimed at grid points often pass exactly
@@ -164,11 +201,12 @@ mod tests {
         };
         let (mut hits, mut fallbacks) = (0, 0);
         for i in 0..20_000 {
-            let (lo, hi) = (block(&mut rng), block(&mut rng));
+            let blocks = [block(&mut rng), block(&mut rng), block(&mut rng), block(&mut rng)];
             let origin = vec3(grid(&mut rng) * 1.5, grid(&mut rng) * 1.5, 4.0 + grid(&mut rng));
+            let aimed = &blocks[(i / 3) % 4];
             let target = match i % 3 {
-                0 => lo.vertex((i / 3) % 3, 0),
-                1 => (hi.vertex(0, 1) + hi.vertex(1, 1)) * 0.5,
+                0 => aimed.vertex((i / 3) % 3, 0),
+                1 => (aimed.vertex(0, 1) + aimed.vertex(1, 1)) * 0.5,
                 _ => vec3(rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0, rng.next_f32() * 4.0 - 2.0),
             };
             let mut ray = Ray::new(origin, target - origin);
@@ -176,33 +214,69 @@ mod tests {
                 ray.t_max = rng.next_f32() * 2.0;
             }
             let r = TriRay::new(&ray);
-            let want =
-                join_hits(&tri4_scalar(&lo, &r, ray.t_min, ray.t_max), &tri4_scalar(&hi, &r, ray.t_min, ray.t_max));
+            let each: Vec<Tri4Hits> = blocks.iter().map(|b| tri4_scalar(b, &r, ray.t_min, ray.t_max)).collect();
+            let want8: TriHits<8> = concat_hits(&each[..2]);
+            let want16: TriHits<16> = concat_hits(&each);
             // SAFETY: the path is available (asserted above).
-            let got = unsafe { S::tri8(&lo, &hi, &r, ray.t_min, ray.t_max) };
-            assert_eq!(got.mask, want.mask, "{path}: lanes hit, ray {ray:?}");
-            for lane in (0..8).filter(|l| want.mask >> l & 1 == 1) {
-                let bits = |h: &TriHits<8>| [h.t[lane].to_bits(), h.b1[lane].to_bits(), h.b2[lane].to_bits()];
-                assert_eq!(bits(&got), bits(&want), "{path}: lane {lane}, ray {ray:?}");
-            }
-            hits += want.mask.count_ones();
-            fallbacks += (0..2).any(|b| {
-                let blk = if b == 0 { &lo } else { &hi };
-                (0..4).any(|l| crate::accel::tri4::tri_lane_has_zero_edge(blk, l, &r))
-            }) as u32;
+            let got8 = unsafe { S::tri8(&blocks[0], &blocks[1], &r, ray.t_min, ray.t_max) };
+            let [a, b, c, d] = &blocks;
+            // SAFETY: as above.
+            let got16 = unsafe { S::tri16([a, b, c, d], &r, ray.t_min, ray.t_max) };
+            same_hits(&got8, &want8, path, &ray);
+            same_hits(&got16, &want16, path, &ray);
+            hits += want16.mask.count_ones();
+            fallbacks +=
+                blocks.iter().any(|blk| (0..4).any(|l| crate::accel::tri4::tri_lane_has_zero_edge(blk, l, &r))) as u32;
         }
         // The cases that matter were exercised: hits, and zero edge functions.
-        assert!(hits > 1000 && fallbacks > 100, "{path}: {hits} hits, {fallbacks} pairs with a zero edge");
+        assert!(hits > 2000 && fallbacks > 200, "{path}: {hits} hits, {fallbacks} groups with a zero edge");
+    }
+
+    fn same_hits<const N: usize>(got: &TriHits<N>, want: &TriHits<N>, path: SimdPath, ray: &Ray) {
+        assert_eq!(got.mask, want.mask, "{path}: lanes hit of {N}, ray {ray:?}");
+        for lane in (0..N).filter(|l| want.mask >> l & 1 == 1) {
+            let bits = |h: &TriHits<N>| [h.t[lane].to_bits(), h.b1[lane].to_bits(), h.b2[lane].to_bits()];
+            assert_eq!(bits(got), bits(want), "{path}: lane {lane} of {N}, ray {ray:?}");
+        }
     }
 
     #[test]
-    fn tri8_is_two_tri4_tests_on_every_path() {
-        check_tri8::<Scalar>(SimdPath::Scalar);
+    fn grouped_triangle_tests_are_the_single_block_tests_on_every_path() {
+        check_grouped_tests::<Scalar>(SimdPath::Scalar);
         #[cfg(target_arch = "x86_64")]
         {
-            check_tri8::<Sse>(SimdPath::Sse);
+            check_grouped_tests::<Sse>(SimdPath::Sse);
             if SimdPath::Avx2.is_available() {
-                check_tri8::<Avx2>(SimdPath::Avx2);
+                check_grouped_tests::<Avx2>(SimdPath::Avx2);
+            }
+            if SimdPath::Avx512.is_available() {
+                check_grouped_tests::<Avx512>(SimdPath::Avx512);
+            } else {
+                eprintln!("no AVX-512 on this CPU: its kernels are not tested here");
+            }
+        }
+    }
+
+    /// `compress_refs` on every path and every mask of an 8-wide node: the set children,
+    /// lowest first.
+    #[test]
+    fn compress_refs_keeps_the_set_children_in_order() {
+        fn check<S: Isa>(path: SimdPath) {
+            let children: [u32; 8] = std::array::from_fn(|i| 100 + i as u32 * 7);
+            for mask in 0..=255u32 {
+                let mut out = [u32::MAX; 8];
+                // SAFETY: the path is available; `out` holds eight `u32`s.
+                let n = unsafe { S::compress_refs(&children, mask, out.as_mut_ptr()) };
+                let want: Vec<u32> = (0..8).filter(|i| mask >> i & 1 == 1).map(|i| children[i]).collect();
+                assert_eq!(&out[..n], &want[..], "{path}: mask {mask:#x}");
+            }
+        }
+        check::<Scalar>(SimdPath::Scalar);
+        #[cfg(target_arch = "x86_64")]
+        {
+            check::<Sse>(SimdPath::Sse);
+            if SimdPath::Avx512.is_available() {
+                check::<Avx512>(SimdPath::Avx512);
             }
         }
     }
