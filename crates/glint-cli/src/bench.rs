@@ -37,7 +37,7 @@ pub struct BenchArgs {
     /// Acceleration structure: wide (the renderer's), wide4, wide8, or binary (the reference).
     #[arg(long, default_value = "wide", value_parser = ["wide", "wide4", "wide8", "binary"])]
     bvh: String,
-    /// SIMD path: auto (best the CPU has), avx2, sse, scalar.
+    /// SIMD path: auto (best the CPU has), avx512, avx2, sse, scalar.
     #[arg(long, default_value = "auto")]
     simd: String,
     /// Split strategy of the binary build that the wide BVH is collapsed from.

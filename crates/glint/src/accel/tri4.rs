@@ -92,22 +92,13 @@ impl<const N: usize> TriHits<N> {
 /// Two blocks' results side by side: `lo`'s lanes first, as one test of both would give.
 #[inline(always)]
 pub fn join_hits(lo: &Tri4Hits, hi: &Tri4Hits) -> TriHits<8> {
-    concat_hits(&[*lo, *hi])
-}
-
-/// Several tests' results side by side, in order: `M` lanes from `parts.len()` tests of `N`.
-///
-/// Panics unless `M == N * parts.len()` and `M <= 32` (the mask's width).
-#[inline(always)]
-pub fn concat_hits<const N: usize, const M: usize>(parts: &[TriHits<N>]) -> TriHits<M> {
-    assert!(M == N * parts.len() && M <= 32, "concat_hits: {} tests of {N} lanes are not {M}", parts.len());
-    let mut h = TriHits::<M>::NONE;
-    for (i, p) in parts.iter().enumerate() {
-        h.mask |= p.mask << (N * i);
-        h.t[N * i..N * (i + 1)].copy_from_slice(&p.t);
-        h.b1[N * i..N * (i + 1)].copy_from_slice(&p.b1);
-        h.b2[N * i..N * (i + 1)].copy_from_slice(&p.b2);
-    }
+    let mut h = TriHits::<8> { mask: lo.mask | (hi.mask << 4), ..TriHits::NONE };
+    h.t[..4].copy_from_slice(&lo.t);
+    h.t[4..].copy_from_slice(&hi.t);
+    h.b1[..4].copy_from_slice(&lo.b1);
+    h.b1[4..].copy_from_slice(&hi.b1);
+    h.b2[..4].copy_from_slice(&lo.b2);
+    h.b2[4..].copy_from_slice(&hi.b2);
     h
 }
 

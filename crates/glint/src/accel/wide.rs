@@ -440,16 +440,15 @@ impl<const W: usize> WideBvh<W> {
                 }
                 mask &= !leaf_bits;
                 if mask != 0 {
-                    // Push every hit child (one compress on AVX-512) and go on with the last;
-                    // in any-hit traversal the order changes the time, never the answer.
+                    // Go on with the first hit child and push the others (one compress on
+                    // AVX-512).
+                    cur = node.children[mask.trailing_zeros() as usize];
+                    mask &= mask - 1;
                     // SAFETY: a node at depth d starts with `sp <= (d - 1)(W - 1)` (each level
                     // of the current path leaves at most W - 1 entries), so the W slots
-                    // written end at index `(d - 1)(W - 1) + W - 1 = d(W - 1) < STACK`, which
-                    // `collapse` checked; `MaybeUninit<u32>` has the layout of `u32`.
-                    let n = unsafe { S::compress_refs(&node.children, mask, stack.as_mut_ptr().add(sp).cast()) };
-                    sp += n - 1;
-                    // SAFETY: `compress_refs` wrote entries `sp - (n - 1)..=sp`.
-                    cur = unsafe { stack.get_unchecked(sp).assume_init() };
+                    // `compress_refs` may write end at index `(d - 1)(W - 1) + W - 1 = d(W - 1)
+                    // < STACK`, which `collapse` checked; `MaybeUninit<u32>` is laid out as `u32`.
+                    sp += unsafe { S::compress_refs(&node.children, mask, stack.as_mut_ptr().add(sp).cast()) };
                     continue;
                 }
             } else if !nr.t_min.is_nan() {

@@ -26,30 +26,15 @@ unsafe fn leaf_blocks(blocks: &[Tri4], first: u32, count: u32) -> &[Tri4] {
     unsafe { blocks.get_unchecked(first as usize..(first + count) as usize) }
 }
 
-/// Closest hit among leaves' blocks of four, tested in groups of `S::BLOCKS_PER_TEST` (two
-/// per AVX2 test, four per AVX-512 test). Testing a group and taking its nearest lane, the
-/// first among equals, is what testing its blocks in turn with a shrinking interval gives,
-/// so the hit is the same bits whatever the grouping.
+/// Closest hit among leaves' blocks of four, tested two blocks at a time (one AVX2 test;
+/// four blocks in one 16-lane AVX-512 test were slower, see BENCHMARKS.md).
+/// Testing a pair and taking its nearest lane, the first among equals, is what testing the
+/// two blocks in turn with a shrinking interval gives, so the hit is the same bits.
 struct Closest<'a, S> {
     blocks: &'a [Tri4],
     tr: TriRay,
     best: Option<(u32, TriangleHit)>,
     isa: PhantomData<S>,
-}
-
-/// Blocks waiting for a full group: `blocks[..len]`.
-struct Group<'a> {
-    blocks: [&'a Tri4; 4],
-    len: usize,
-}
-
-/// Fills the unused entries of a [`Group`]; never tested.
-static NO_BLOCK: Tri4 = Tri4::EMPTY;
-
-impl<'a> Group<'a> {
-    fn new() -> Group<'a> {
-        Group { blocks: [&NO_BLOCK; 4], len: 0 }
-    }
 }
 
 impl<'a, S: Isa> Closest<'a, S> {
@@ -61,63 +46,56 @@ impl<'a, S: Isa> Closest<'a, S> {
         true
     }
 
-    /// Adds `blocks` to `group`, testing it each time it is full; leaves the rest in it.
+    /// Tests `blocks` in pairs, the first paired with `pending` (a block left over from an
+    /// earlier leaf) if there is one; leaves the last unpaired block in `pending`.
     #[inline(always)]
-    fn feed(&mut self, group: &mut Group<'a>, blocks: &'a [Tri4], r: &mut Ray) -> bool {
+    fn feed(&mut self, pending: &mut Option<&'a Tri4>, blocks: &'a [Tri4], r: &mut Ray) -> bool {
         let mut hit = false;
         for b in blocks {
-            group.blocks[group.len] = b;
-            group.len += 1;
-            if group.len == S::BLOCKS_PER_TEST.clamp(2, 4) {
-                hit |= self.test_group(group, r);
-            }
+            let Some(a) = pending.take() else {
+                *pending = Some(b);
+                continue;
+            };
+            // SAFETY: `S` is available (the only callers are `intersect_generic`'s and
+            // `intersect_batch_generic`'s, which require it); the kernel reads only `a`, `b`
+            // and `self.tr`.
+            let h = unsafe { S::tri8(a, b, &self.tr, r.t_min, r.t_max) };
+            hit |= self.take(&h, |lane| if lane < 4 { a.prim[lane] } else { b.prim[lane - 4] }, r);
         }
         hit
     }
 
-    /// Tests the blocks of `group` (one to four) in one test and empties it.
+    /// Tests the block left unpaired, if any.
     #[inline(always)]
-    fn test_group(&mut self, group: &mut Group<'a>, r: &mut Ray) -> bool {
-        let (tr, t_min, t_max) = (&self.tr, r.t_min, r.t_max);
-        let g = group.blocks;
-        let len = std::mem::replace(&mut group.len, 0);
-        let prim = |lane: usize| g[lane / 4].prim[lane % 4];
-        // SAFETY (every arm): `S` is available (the only callers are `intersect_generic`'s
-        // and `intersect_batch_generic`'s, which require it); the kernels read only the
-        // blocks and `self.tr`.
-        match len {
-            0 => false,
-            1 => self.take(&unsafe { S::tri4(g[0], tr, t_min, t_max) }, prim, r),
-            2 => self.take(&unsafe { S::tri8(g[0], g[1], tr, t_min, t_max) }, prim, r),
-            // Three blocks: the third again in the fourth place, whose lanes lose every tie
-            // to the same lanes in the third place.
-            3 => self.take(&unsafe { S::tri16([g[0], g[1], g[2], g[2]], tr, t_min, t_max) }, prim, r),
-            _ => self.take(&unsafe { S::tri16(g, tr, t_min, t_max) }, prim, r),
-        }
+    fn finish(&mut self, pending: Option<&'a Tri4>, r: &mut Ray) -> bool {
+        let Some(a) = pending else { return false };
+        // SAFETY: as in `feed`.
+        let h = unsafe { S::tri4(a, &self.tr, r.t_min, r.t_max) };
+        self.take(&h, |lane| a.prim[lane], r)
     }
 }
 
 impl<S: Isa> ClosestLeaf for Closest<'_, S> {
     #[inline(always)]
     fn test(&mut self, first: u32, count: u32, r: &mut Ray) -> bool {
-        let mut group = Group::new();
+        let mut pending = None;
         // SAFETY: traversal passes only hit leaves' ranges (see `leaf_blocks`).
-        let hit = self.feed(&mut group, unsafe { leaf_blocks(self.blocks, first, count) }, r);
-        hit | self.test_group(&mut group, r)
+        let hit = self.feed(&mut pending, unsafe { leaf_blocks(self.blocks, first, count) }, r);
+        hit | self.finish(pending, r)
     }
 
     #[inline(always)]
     fn test_leaves<const W: usize>(&mut self, children: &[u32; W], mask: u32, r: &mut Ray) -> bool {
-        let mut group = Group::new();
+        let mut pending = None;
         let mut hit = false;
         let mut m = mask;
         while m != 0 {
             let (first, count) = leaf_range(children[m.trailing_zeros() as usize]);
             m &= m - 1;
             // SAFETY: the set bits of `mask` are hit leaf children (see `leaf_blocks`).
-            hit |= self.feed(&mut group, unsafe { leaf_blocks(self.blocks, first, count) }, r);
+            hit |= self.feed(&mut pending, unsafe { leaf_blocks(self.blocks, first, count) }, r);
         }
-        hit | self.test_group(&mut group, r)
+        hit | self.finish(pending, r)
     }
 }
 

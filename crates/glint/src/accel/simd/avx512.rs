@@ -1,14 +1,14 @@
-//! AVX-512 (F and VL): the node test compares straight into a mask register, four blocks
-//! of four triangles are one 16-lane test, and any-hit traversal pushes a node's hit
-//! children with one compress. Everything else is the AVX2 path's, compiled with AVX-512 on.
+//! AVX-512 (F and VL): the node test compares straight into a mask register, and any-hit
+//! traversal pushes a node's hit children with one compress. The triangle tests are the AVX2
+//! path's, compiled with AVX-512 on: four blocks in one 16-lane test were measured 13 to 17%
+//! slower on closest hits than two blocks in one 8-lane test (BENCHMARKS.md, Sapphire Rapids).
 //!
-//! Same operations as `tri4_sse` and `Avx2::node`, lane for lane, so the same bits: the
-//! 512-bit and mask-register forms of the same IEEE instructions with SSE's comparison
-//! predicates (`cmpeq` EQ_OQ, `cmplt` LT_OS, `cmpgt` GT_OS, `cmpneq` NEQ_UQ, `cmple` LE_OQ).
+//! The node test is `Avx2::node`'s operations, lane for lane, with the mask-register form of
+//! the same comparison (`cmple`, LE_OQ), so the same bits.
 
 use super::sse::tri4_sse;
 use super::{Avx2, Isa};
-use crate::accel::tri4::{concat_hits, Tri4, Tri4Hits, TriHits, TriRay};
+use crate::accel::tri4::{Tri4, Tri4Hits, TriHits, TriRay};
 use crate::accel::wide::{NodeRay, WideNode, FAR_SCALE};
 use std::arch::x86_64::*;
 
@@ -51,13 +51,6 @@ unsafe impl Isa for Avx512 {
         Avx2::tri8(lo, hi, r, t_min, t_max)
     }
 
-    const BLOCKS_PER_TEST: usize = 4;
-
-    #[inline(always)]
-    unsafe fn tri16(blocks: [&Tri4; 4], r: &TriRay, t_min: f32, t_max: f32) -> TriHits<16> {
-        tri16_avx512(blocks, r, t_min, t_max)
-    }
-
     #[inline(always)]
     unsafe fn compress_refs<const W: usize>(children: &[u32; W], mask: u32, out: *mut u32) -> usize {
         if W != 8 {
@@ -69,70 +62,4 @@ unsafe impl Isa for Avx512 {
         _mm256_storeu_si256(out.cast(), _mm256_maskz_compress_epi32(mask as u8, refs));
         (mask & 0xff).count_ones() as usize
     }
-}
-
-/// The watertight test on four blocks at once, operation for operation as `tri4_sse` (and
-/// so `tri_lane`) on each block.
-#[inline(always)]
-unsafe fn tri16_avx512(blocks: [&Tri4; 4], r: &TriRay, t_min: f32, t_max: f32) -> TriHits<16> {
-    let [kx, ky, kz] = r.k;
-    // SAFETY: `TriRay` axes are < 3, and `Tri4` is 16-byte aligned with rows of four floats
-    // at multiples of 16 bytes, as the aligned loads need.
-    let rel = |k: usize, axis: usize| {
-        let row = |i: usize| _mm_load_ps(blocks[i].v[k].get_unchecked(axis).as_ptr());
-        let v = _mm512_castps128_ps512(row(0));
-        let v = _mm512_insertf32x4::<1>(v, row(1));
-        let v = _mm512_insertf32x4::<2>(v, row(2));
-        let v = _mm512_insertf32x4::<3>(v, row(3));
-        _mm512_sub_ps(v, _mm512_set1_ps(*r.o.get_unchecked(axis)))
-    };
-    let (a_x, a_y, a_z) = (rel(0, kx), rel(0, ky), rel(0, kz));
-    let (b_x, b_y, b_z) = (rel(1, kx), rel(1, ky), rel(1, kz));
-    let (c_x, c_y, c_z) = (rel(2, kx), rel(2, ky), rel(2, kz));
-    let (sx, sy, sz) = (_mm512_set1_ps(r.s[0]), _mm512_set1_ps(r.s[1]), _mm512_set1_ps(r.s[2]));
-    let ax = _mm512_sub_ps(a_x, _mm512_mul_ps(sx, a_z));
-    let ay = _mm512_sub_ps(a_y, _mm512_mul_ps(sy, a_z));
-    let bx = _mm512_sub_ps(b_x, _mm512_mul_ps(sx, b_z));
-    let by = _mm512_sub_ps(b_y, _mm512_mul_ps(sy, b_z));
-    let cx = _mm512_sub_ps(c_x, _mm512_mul_ps(sx, c_z));
-    let cy = _mm512_sub_ps(c_y, _mm512_mul_ps(sy, c_z));
-    let u = _mm512_sub_ps(_mm512_mul_ps(cx, by), _mm512_mul_ps(cy, bx));
-    let v = _mm512_sub_ps(_mm512_mul_ps(ax, cy), _mm512_mul_ps(ay, cx));
-    let w = _mm512_sub_ps(_mm512_mul_ps(bx, ay), _mm512_mul_ps(by, ax));
-    let zero = _mm512_setzero_ps();
-    let eq = |x| _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(x, zero);
-    let lt = |x| _mm512_cmp_ps_mask::<_CMP_LT_OS>(x, zero);
-    let gt = |x| _mm512_cmp_ps_mask::<_CMP_GT_OS>(x, zero);
-    let zero_bits = eq(u) | eq(v) | eq(w);
-    // Inside unless some edge function is negative and some positive.
-    let outside = (lt(u) | lt(v) | lt(w)) & (gt(u) | gt(v) | gt(w));
-    if zero_bits == 0 && outside == 0xffff {
-        // Most groups: the ray passes outside all sixteen triangles.
-        return TriHits::NONE;
-    }
-    if zero_bits != 0 {
-        // An edge function is exactly zero: each block as the four-lane kernel does it
-        // (which redoes such a block in double precision).
-        let [a, b, c, d] = blocks;
-        let each = |blk| tri4_sse(blk, r, t_min, t_max);
-        return concat_hits(&[each(a), each(b), each(c), each(d)]);
-    }
-    let det = _mm512_add_ps(_mm512_add_ps(u, v), w);
-    let ok = _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(det, zero);
-    let t_scaled = _mm512_add_ps(
-        _mm512_add_ps(_mm512_mul_ps(u, _mm512_mul_ps(sz, a_z)), _mm512_mul_ps(v, _mm512_mul_ps(sz, b_z))),
-        _mm512_mul_ps(w, _mm512_mul_ps(sz, c_z)),
-    );
-    let inv = _mm512_div_ps(_mm512_set1_ps(1.0), det);
-    let t = _mm512_mul_ps(t_scaled, inv);
-    let in_range = _mm512_cmp_ps_mask::<_CMP_GT_OS>(t, _mm512_set1_ps(t_min))
-        & _mm512_cmp_ps_mask::<_CMP_LT_OS>(t, _mm512_set1_ps(t_max));
-    let mask = (ok & in_range & !outside) as u32;
-    let mut h = TriHits::<16> { mask, ..TriHits::NONE };
-    if mask != 0 {
-        _mm512_storeu_ps(h.t.as_mut_ptr(), t);
-        _mm512_storeu_ps(h.b1.as_mut_ptr(), _mm512_mul_ps(v, inv));
-        _mm512_storeu_ps(h.b2.as_mut_ptr(), _mm512_mul_ps(w, inv));
-    }
-    h
 }
