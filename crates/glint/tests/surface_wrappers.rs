@@ -80,13 +80,16 @@ fn a_half_opaque_sheet_halves_light_on_shadow_rays() {
         }
     }
     assert!((b - 0.5 * a).abs() < 1e-5 * a);
-    // The path tracer also reaches the light through the sheet by BSDF sampling (a random
+    // The path tracers also reach the light through the sheet by BSDF sampling (a random
     // pass with probability 0.5), so there the half holds in expectation.
-    let path = r#"<integrator type="path"/>"#;
-    let (a, ea) = mean_and_error(&render_xml(&dir, "plain-path", &scene(path, None, 0.5, 2.0)));
-    let (b, eb) = mean_and_error(&render_xml(&dir, "masked-path", &scene(path, Some(1.0), 0.5, 2.0)));
-    let tol = 4.0 * (eb * eb + 0.25 * ea * ea).sqrt();
-    assert!((b - 0.5 * a).abs() < tol, "path: {b} vs half of {a} (tolerance {tol})");
+    for (name, integrator) in [("path", r#"<integrator type="path"/>"#), ("volpath", r#"<integrator type="volpath"/>"#)]
+    {
+        let (a, ea) = mean_and_error(&render_xml(&dir, &format!("plain-{name}"), &scene(integrator, None, 0.5, 2.0)));
+        let (b, eb) =
+            mean_and_error(&render_xml(&dir, &format!("masked-{name}"), &scene(integrator, Some(1.0), 0.5, 2.0)));
+        let tol = 4.0 * (eb * eb + 0.25 * ea * ea).sqrt();
+        assert!((b - 0.5 * a).abs() < tol, "{name}: {b} vs half of {a} (tolerance {tol})");
+    }
 }
 
 #[test]
@@ -94,7 +97,11 @@ fn a_half_opaque_sheet_halves_what_the_camera_sees_through_it() {
     let dir = scratch("camera");
     // The light is under the sheet, the camera above: camera rays pass with probability 0.5
     // and the black sheet returns nothing when they do not.
-    for (name, integrator) in [("direct", DIRECT_LIGHT_SAMPLES), ("path", r#"<integrator type="path"/>"#)] {
+    for (name, integrator) in [
+        ("direct", DIRECT_LIGHT_SAMPLES),
+        ("path", r#"<integrator type="path"/>"#),
+        ("volpath", r#"<integrator type="volpath"/>"#),
+    ] {
         let (a, ea) = mean_and_error(&render_xml(&dir, &format!("{name}-plain"), &scene(integrator, None, 3.0, 0.8)));
         let (b, eb) =
             mean_and_error(&render_xml(&dir, &format!("{name}-masked"), &scene(integrator, Some(1.5), 3.0, 0.8)));

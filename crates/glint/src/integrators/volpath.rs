@@ -10,7 +10,8 @@
 //! combined by MIS as at surfaces. Surfaces with a `null` BSDF (and the straight-through
 //! lobe of a thin dielectric) are passages, not scattering events: paths go on through them
 //! without counting depth, and shadow rays pass through them, attenuated by every medium
-//! they cross. A shape that bounds media switches the ray's medium to the one on the side
+//! they cross. A masked surface (`mask`) is a passage with probability 1 - opacity: paths
+//! pass it at random, as in `path`, and shadow rays carry its 1 - opacity. A shape that bounds media switches the ray's medium to the one on the side
 //! the ray leaves to. Surfaces without media behave exactly as in `path`.
 //!
 //! Depth counts scattering events (in media and at surfaces, not passages), as Mitsuba's
@@ -21,6 +22,7 @@
 //! rays' transmittance by ratio tracking, both against the grid's majorant.
 
 use super::path::MAX_PATH_DEPTH;
+use super::surface::opacity;
 use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::bsdf::{fresnel_dielectric, Bsdf, BsdfSample};
 use crate::describe::VolpathSettings;
@@ -41,9 +43,9 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
         return Rgb::BLACK;
     }
     // Shadow rays must look for passages only where there are any.
-    let passable =
-        scene.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }))
-            || !scene.media.is_empty();
+    let passable = scene.has_masks
+        || scene.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }))
+        || !scene.media.is_empty();
     let mut l = Rgb::BLACK;
     let mut throughput = Rgb::WHITE;
     // Undoes the 1/eta^2 radiance scaling for Russian roulette, as in `path`.
@@ -138,6 +140,21 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
                     scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, si.p, si.ng)
                 });
                 l += throughput * le * w;
+            }
+        }
+
+        // A masked surface lets the path through unscattered with probability 1 - opacity:
+        // a passage, as in `path` (depth and the MIS state stay those of the last event).
+        if scene.has_masks {
+            let o = opacity(scene, &si);
+            if o < 1.0 && rng.next_f32() >= o {
+                passages += 1;
+                if passages > MAX_PASSAGES {
+                    break;
+                }
+                medium = boundary.medium_after(ray.dir.dot(si.ng), medium);
+                ray = spawn_ray(&si, ray.dir);
+                continue;
             }
         }
 
@@ -282,8 +299,15 @@ fn transmittance(
         }
         let si = scene.interaction(&ray, &hit);
         let (bsdf, frame) = shading(scene, &si, -ray.dir);
-        let Some(pass) = passage_transmission(&bsdf.bsdf, frame.to_local(-ray.dir)) else {
-            return Rgb::BLACK;
+        let through = passage_transmission(&bsdf.bsdf, frame.to_local(-ray.dir));
+        // A mask passes 1 - opacity unscattered; the surface beneath it passes its share
+        // of the rest if it is itself a passage.
+        let o = if scene.has_masks { opacity(scene, &si) } else { 1.0 };
+        let pass = match through {
+            Some(t) if o < 1.0 => t * o + Rgb::splat(1.0 - o),
+            Some(t) => t,
+            None if o < 1.0 => Rgb::splat(1.0 - o),
+            None => return Rgb::BLACK,
         };
         tr *= pass;
         if tr.is_black() {
