@@ -471,6 +471,7 @@ impl WorldBuilder {
             bvh_split: self.split,
             bvh_build_seconds: 0.0,
             has_masks: false,
+            has_passage_materials: false,
             media: self.media,
             camera_medium: self.camera_medium,
         };

@@ -390,7 +390,7 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
     for (i, m) in materials.into_iter().enumerate() {
         world.materials[i] = m;
     }
-    world.has_masks = world.materials.iter().any(Material::is_masked);
+    world.update_material_flags();
     for (light, e) in emission {
         match &mut world.lights[light] {
             Light::Mesh { radiance, two_sided, .. } => {

@@ -27,7 +27,6 @@ use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::bsdf::{fresnel_dielectric, Bsdf, BsdfSample};
 use crate::describe::VolpathSettings;
 use crate::lights::LightSample;
-use crate::materials::MaterialKind;
 use crate::math::{offset_origin, Ray, Rgb, Vec3};
 use crate::media::{sample_distance, Medium};
 use crate::sampling::{power_heuristic, Sampler};
@@ -43,9 +42,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
         return Rgb::BLACK;
     }
     // Shadow rays must look for passages only where there are any.
-    let passable = scene.has_masks
-        || scene.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }))
-        || !scene.media.is_empty();
+    let passable = scene.has_masks || scene.has_passage_materials || !scene.media.is_empty();
     let mut l = Rgb::BLACK;
     let mut throughput = Rgb::WHITE;
     // Undoes the 1/eta^2 radiance scaling for Russian roulette, as in `path`.

@@ -11,7 +11,7 @@ use crate::accel::{BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{Cylinder, SdfGrid, Sphere, TriangleMesh};
 use crate::lights::{Light, LightSelection};
-use crate::materials::{Material, TexturePoint};
+use crate::materials::{Material, MaterialKind, TexturePoint};
 use crate::math::{Aabb, Frame, Ray, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
 use crate::sampling::Distribution1d;
@@ -103,6 +103,9 @@ pub struct World {
     pub(crate) bvh_build_seconds: f64,
     /// Some material has a mask (`mask`): shadow rays then look past what they hit.
     pub(crate) has_masks: bool,
+    /// Some material is a passage for volpath (`null`, `thindielectric`): its shadow rays
+    /// then look past what they hit. Kept here so that no path scans the materials.
+    pub(crate) has_passage_materials: bool,
     /// Participating media, indexed by [`Instance::media`] and `camera_medium`.
     pub(crate) media: Vec<Medium>,
     /// The medium the camera sits in.
@@ -129,8 +132,17 @@ impl World {
             .collect();
         self.top = TopLevelBvh::build_flattening(&boxes, self.bvh_split, &flat);
         self.bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
-        self.has_masks = self.materials.iter().any(Material::is_masked);
+        self.update_material_flags();
         self.set_light_selection(selection);
+    }
+
+    /// Sets the flags that say which materials the scene has; called whenever they change.
+    pub(crate) fn update_material_flags(&mut self) {
+        self.has_masks = self.materials.iter().any(Material::is_masked);
+        self.has_passage_materials = self
+            .materials
+            .iter()
+            .any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }));
     }
 
     /// The share of next-event light choices made by power under `LightSelection::Power`; the
