@@ -20,9 +20,19 @@ fn floats(path: &PathBuf) -> Vec<f32> {
     std::fs::read(path).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
 }
 
+/// Removes the test's scratch folder when dropped, so a failing test leaves nothing behind.
+struct RemoveOnDrop(PathBuf);
+
+impl Drop for RemoveOnDrop {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
 #[test]
 fn bench_json_is_well_formed_and_hits_match_the_reference() {
     let dir = std::env::temp_dir().join(format!("glint-bench-cli-{}", std::process::id()));
+    let _remove_dir = RemoveOnDrop(dir.clone());
     std::fs::create_dir_all(&dir).unwrap();
     // A small closed-ish mesh: a bumpy grid plus a tetrahedron floating above it.
     let mut obj = String::new();
@@ -142,5 +152,4 @@ fn bench_json_is_well_formed_and_hits_match_the_reference() {
             assert!(n_hit > 100, "the camera should see the mesh");
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }

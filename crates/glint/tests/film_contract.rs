@@ -6,6 +6,7 @@
 mod common;
 
 use common::scenes::{add_glass_and_metal_balls, add_quad, camera, cornell_box_with, diffuse, path};
+use common::scratch::ScratchDir;
 use glint::accel::BvhSplit;
 use glint::build::WorldBuilder;
 use glint::integrators::{Integrator, Strategy, WhittedSettings};
@@ -103,8 +104,7 @@ fn every_schedule_gives_the_same_bits_when_splatting() {
 fn every_schedule_gives_the_same_bits_with(filter: PixelFilter, filter_name: &str) {
     let scene = contract_scene();
     let integrators = [("path", path(Strategy::Mis)), ("Whitted", Integrator::Whitted(WhittedSettings::default()))];
-    let dir = std::env::temp_dir().join(format!("glint-film-contract-{filter_name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = ScratchDir::new(&format!("film-contract-{filter_name}"));
     let new_film = |region| new_filtered_film(region, filter);
     let settings = || RenderSettings { filter, ..settings() };
     for (name, integrator) in &integrators {
@@ -169,7 +169,6 @@ fn every_schedule_gives_the_same_bits_with(filter: PixelFilter, filter_name: &st
         let old_var: Vec<f32> = old.variance.unwrap().pixels.iter().flat_map(|p| p.to_array()).collect();
         assert_eq!(old_var, var, "{name}: render()'s variance differs from the film's");
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -187,15 +186,13 @@ fn adaptive_renders_are_the_same_bits_across_threads_regions_and_checkpoints() {
     run(&scene, &integrator, &mut top, 0..3, adaptive);
     let mut bottom = new_film(Rect { x0: 0, y0: 4, x1: W, y1: H });
     run(&scene, &integrator, &mut bottom, 0..1, adaptive);
-    let dir = std::env::temp_dir().join(format!("glint-film-adaptive-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = ScratchDir::new("film-adaptive");
     let path = dir.join("bottom.glf");
     write_film(&path, &bottom, &FilmMeta::default()).unwrap();
     let (mut bottom, _) = read_film(&path).unwrap();
     run(&scene, &integrator, &mut bottom, 1..3, adaptive);
     top.merge(&bottom).unwrap();
     assert!(bits(&top) == reference, "regions, one resumed from a checkpoint");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

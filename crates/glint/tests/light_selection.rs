@@ -3,14 +3,16 @@
 //! documentation scenes: spheres of power 200, 1, 1, 1, 1, each lighting its own highlight)
 //! had 4x Mitsuba's error when the weak ones were picked 1 time in 204.
 
+mod common;
+
+use common::scratch::ScratchDir;
 use glint::formats::ReadOptions;
 use glint::lights::LightSelection;
 use glint::session::Session;
 use glint::world::World;
 
 fn veach_lights_world(selection: LightSelection) -> std::sync::Arc<World> {
-    let dir = std::env::temp_dir().join(format!("glint-light-selection-{}-{selection:?}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = ScratchDir::new(&format!("light-selection-{selection:?}"));
     let sphere = |x: f32, r: f32, radiance: f32| {
         format!(
             r#"<shape type="sphere"><point name="center" x="{x}" y="0" z="0"/><float name="radius" value="{r}"/>
@@ -29,9 +31,7 @@ fn veach_lights_world(selection: LightSelection) -> std::sync::Arc<World> {
     std::fs::write(&path, scene).unwrap();
     let mut session = Session::open(&path, &ReadOptions::default()).unwrap();
     session.edit().light_selection = selection;
-    let world = session.world().unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
-    world
+    session.world().unwrap()
 }
 
 #[test]

@@ -2,6 +2,9 @@
 //! the JSON format's `media` describe the same thing; what glint cannot render is one
 //! clean error per feature, each naming its file and line, all in one run.
 
+mod common;
+
+use common::scratch::ScratchDir;
 use glint::describe::{GridFilter, GridWrap, IntegratorDesc, PhaseDesc, SceneDesc, VolumeDesc};
 use glint::formats::{json, mitsuba};
 use glint::math::Rgb;
@@ -251,8 +254,7 @@ fn vol_bytes(res: [i32; 3], channels: i32, values: &[f32]) -> Vec<u8> {
 
 #[test]
 fn bad_albedo_grid_files_are_one_line_errors_at_build() {
-    let dir = std::env::temp_dir().join(format!("glint-media-grid-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = ScratchDir::new("media-grid");
     let cases: [(&str, Vec<u8>, &str); 5] = [
         ("truncated.vol", vol_bytes([2, 2, 2], 3, &[0.5; 20]), "truncated volume grid"),
         ("channels.vol", vol_bytes([1, 1, 1], 2, &[0.5; 2]), "2 channels cannot be an albedo"),
@@ -317,8 +319,7 @@ fn heterogeneous_media_take_a_density_grid_as_sigma_t() {
 
 #[test]
 fn bad_density_grids_are_one_line_errors_at_build() {
-    let dir = std::env::temp_dir().join(format!("glint-media-density-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = ScratchDir::new("media-density");
     for (name, bytes, what) in [
         ("rgb.vol", vol_bytes([1, 1, 1], 3, &[0.5; 3]), "1 channel, not 3"),
         ("negative.vol", vol_bytes([2, 1, 1], 1, &[0.5, -1.0]), "density -1"),

@@ -3,11 +3,15 @@
 mod common;
 
 use common::load::load;
-use std::path::PathBuf;
+use common::scratch::ScratchDir;
+use std::path::{Path, PathBuf};
 
-fn write(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("glint-mitsuba-errors-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// A folder for one test's files: tests run in parallel, so each needs its own.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new(&format!("mitsuba-errors-{test}"))
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
     p
@@ -16,8 +20,8 @@ fn write(name: &str, text: &str) -> PathBuf {
 const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="40"/>
   <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>"#;
 
-fn error_of(name: &str, text: &str) -> String {
-    let p = write(name, text);
+fn error_of(dir: &Path, name: &str, text: &str) -> String {
+    let p = write(dir, name, text);
     match load(&p, &[], None) {
         Ok(_) => panic!("{name} loaded but should not"),
         Err(e) => {
@@ -29,35 +33,46 @@ fn error_of(name: &str, text: &str) -> String {
 
 #[test]
 fn malformed_xml() {
-    let e = error_of("malformed.xml", "<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n</scene>\n");
+    let dir = scratch("malformed");
+    let e = error_of(&dir, "malformed.xml", "<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n</scene>\n");
     assert!(e.contains("malformed.xml:") && e.contains("malformed XML"), "{e}");
 }
 
 #[test]
 fn unknown_plugin_names_type_file_and_line() {
+    let dir = scratch("unknown-plugin");
     let e = error_of(
+        &dir,
         "plugin.xml",
         &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"sphere\">\n <bsdf type=\"velvet\"/>\n</shape>\n</scene>\n"),
     );
     assert!(e.contains("plugin.xml:5:") && e.contains("velvet"), "{e}");
-    let e = error_of("shape.xml", &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"hair\"/>\n</scene>\n"));
+    let e = error_of(
+        &dir,
+        "shape.xml",
+        &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"hair\"/>\n</scene>\n"),
+    );
     assert!(e.contains("shape.xml:4:") && e.contains("hair"), "{e}");
 }
 
 #[test]
 fn missing_referenced_file() {
+    let dir = scratch("missing-file");
     let e = error_of(
+        &dir,
         "missing.xml",
         &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"obj\">\n <string name=\"filename\" value=\"nowhere.obj\"/>\n</shape>\n</scene>\n"),
     );
     assert!(e.contains("missing.xml:4:") && e.contains("nowhere.obj"), "{e}");
-    let e = error_of("include.xml", "<scene version=\"3.0.0\">\n<include filename=\"gone.xml\"/>\n</scene>\n");
+    let e = error_of(&dir, "include.xml", "<scene version=\"3.0.0\">\n<include filename=\"gone.xml\"/>\n</scene>\n");
     assert!(e.contains("include.xml:2:") && e.contains("gone.xml"), "{e}");
 }
 
 #[test]
 fn substitution_without_default() {
+    let dir = scratch("substitution");
     let e = error_of(
+        &dir,
         "subst.xml",
         &format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"sphere\">\n <float name=\"radius\" value=\"$r\"/>\n</shape>\n</scene>\n"),
     );
@@ -66,15 +81,16 @@ fn substitution_without_default() {
 
 #[test]
 fn defines_override_defaults_and_refs_resolve() {
+    let dir = scratch("defines");
     let text = format!(
         "<scene version=\"3.0.0\">\n<default name=\"r\" value=\"0.5\"/>\n{SENSOR}\n<bsdf type=\"diffuse\" id=\"m\"/>\n<shape type=\"sphere\">\n <float name=\"radius\" value=\"$r\"/>\n <ref id=\"m\"/>\n</shape>\n</scene>\n"
     );
-    let p = write("ok.xml", &text);
+    let p = write(&dir, "ok.xml", &text);
     let s = load(&p, &[], None).unwrap();
     assert!((s.world.spheres()[0].radius - 0.5).abs() < 1e-6);
     let s = load(&p, &[("r", "2")], None).unwrap();
     assert!((s.world.spheres()[0].radius - 2.0).abs() < 1e-6);
-    let e = error_of("badref.xml", &text.replace("<ref id=\"m\"/>", "<ref id=\"nope\"/>"));
+    let e = error_of(&dir, "badref.xml", &text.replace("<ref id=\"m\"/>", "<ref id=\"nope\"/>"));
     assert!(e.contains("badref.xml:8:") && e.contains("nope"), "{e}");
 }
 
@@ -105,6 +121,7 @@ fn a_define_without_a_default_is_a_warning() {
 /// or no sample at all is an error.
 #[test]
 fn direct_integrator_sample_counts() {
+    let dir = scratch("direct-counts");
     use glint::describe::{DirectSettings, IntegratorDesc};
     let scene = |params: &str| {
         format!("<scene version=\"3.0.0\">\n{SENSOR}\n<integrator type=\"direct\">{params}</integrator>\n</scene>\n")
@@ -130,7 +147,7 @@ fn direct_integrator_sample_counts() {
         (r#"<integer name="emitter_samples" value="-1"/>"#, "out of range"),
         (r#"<integer name="emitter_samples" value="0"/><integer name="bsdf_samples" value="0"/>"#, "at least one"),
     ] {
-        let e = error_of("direct.xml", &scene(params));
+        let e = error_of(&dir, "direct.xml", &scene(params));
         assert!(e.contains("direct.xml:4:") && e.contains(needle), "{params}: {e}");
     }
 }
@@ -153,42 +170,47 @@ fn sdf_scene(shape_body: &str) -> String {
 
 #[test]
 fn sdfgrid_bad_files_and_parameters() {
-    let dir = write("sdf-dummy.txt", "").parent().unwrap().to_path_buf();
+    let dir = scratch("sdfgrid");
     // Missing file, a file that is not a grid, a truncated one, three channels, no surface.
-    let e = error_of("sdf-missing.xml", &sdf_scene(" <string name=\"filename\" value=\"nowhere.vol\"/>"));
+    let e = error_of(&dir, "sdf-missing.xml", &sdf_scene(" <string name=\"filename\" value=\"nowhere.vol\"/>"));
     assert!(e.contains("sdf-missing.xml:4:") && e.contains("nowhere.vol"), "{e}");
     std::fs::write(dir.join("sdf-text.vol"), "not a grid").unwrap();
-    let e = error_of("sdf-corrupt.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-text.vol\"/>"));
+    let e = error_of(&dir, "sdf-corrupt.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-text.vol\"/>"));
     assert!(e.contains("sdf-corrupt.xml:4:") && e.contains("VOL"), "{e}");
     let mut short = vol_bytes([2, 2, 2], 1, &[1.0; 8]);
     short.truncate(short.len() - 4);
     std::fs::write(dir.join("sdf-short.vol"), short).unwrap();
-    let e = error_of("sdf-short.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-short.vol\"/>"));
+    let e = error_of(&dir, "sdf-short.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-short.vol\"/>"));
     assert!(e.contains("sdf-short.xml:4:") && e.contains("sdf-short.vol"), "{e}");
     std::fs::write(dir.join("sdf-rgb.vol"), vol_bytes([2, 2, 2], 3, &[1.0; 24])).unwrap();
-    let e = error_of("sdf-rgb.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-rgb.vol\"/>"));
+    let e = error_of(&dir, "sdf-rgb.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-rgb.vol\"/>"));
     assert!(e.contains("sdf-rgb.xml:4:") && e.contains("1 channel, this one has 3"), "{e}");
     std::fs::write(dir.join("sdf-empty.vol"), vol_bytes([2, 2, 2], 1, &[1.0; 8])).unwrap();
-    let e = error_of("sdf-empty.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-empty.vol\"/>"));
+    let e = error_of(&dir, "sdf-empty.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-empty.vol\"/>"));
     assert!(e.contains("sdf-empty.xml:4:") && e.contains("no surface"), "{e}");
     std::fs::write(dir.join("sdf-flat.vol"), vol_bytes([1, 2, 2], 1, &[1.0; 4])).unwrap();
-    let e = error_of("sdf-flat.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-flat.vol\"/>"));
+    let e = error_of(&dir, "sdf-flat.xml", &sdf_scene(" <string name=\"filename\" value=\"sdf-flat.vol\"/>"));
     assert!(e.contains("sdf-flat.xml:4:") && e.contains("at least 2 samples"), "{e}");
 
     // Unsupported parameters and uses.
     let good = vol_bytes([2, 2, 2], 1, &[-1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0]);
     std::fs::write(dir.join("sdf-good.vol"), good).unwrap();
     let file = " <string name=\"filename\" value=\"sdf-good.vol\"/>";
-    let e = error_of("sdf-normals.xml", &sdf_scene(&format!("{file}\n <string name=\"normals\" value=\"flat\"/>")));
+    let e =
+        error_of(&dir, "sdf-normals.xml", &sdf_scene(&format!("{file}\n <string name=\"normals\" value=\"flat\"/>")));
     assert!(e.contains("sdf-normals.xml:6:") && e.contains("'flat'"), "{e}");
-    let e = error_of("sdf-noname.xml", &sdf_scene(" <string name=\"normals\" value=\"smooth\"/>"));
+    let e = error_of(&dir, "sdf-noname.xml", &sdf_scene(" <string name=\"normals\" value=\"smooth\"/>"));
     assert!(e.contains("sdf-noname.xml:4:") && e.contains("needs 'filename'"), "{e}");
     let emitter = "<emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter>";
-    let e = error_of("sdf-emit.xml", &sdf_scene(&format!("{file}\n {emitter}")));
+    let e = error_of(&dir, "sdf-emit.xml", &sdf_scene(&format!("{file}\n {emitter}")));
     assert!(e.contains("sdf-emit.xml:4:") && e.contains("cannot emit"), "{e}");
-    let e = error_of("sdf-flip.xml", &sdf_scene(&format!("{file}\n <boolean name=\"flip_normals\" value=\"true\"/>")));
+    let e = error_of(
+        &dir,
+        "sdf-flip.xml",
+        &sdf_scene(&format!("{file}\n <boolean name=\"flip_normals\" value=\"true\"/>")),
+    );
     assert!(e.contains("sdf-flip.xml:4:") && e.contains("flip_normals"), "{e}");
     // The good grid loads, by itself and through an instance.
-    let p = write("sdf-ok.xml", &sdf_scene(file));
+    let p = write(&dir, "sdf-ok.xml", &sdf_scene(file));
     assert!(load(&p, &[], None).is_ok());
 }

@@ -5,16 +5,14 @@
 mod common;
 
 use common::load::load;
+use common::scratch::ScratchDir;
 use glint::describe::{Geometry, LightKind, MaterialModel, SceneDesc, TextureDesc};
 use glint::formats::{Define, ReadOptions};
 use std::path::{Path, PathBuf};
 
-/// A fresh folder for one test's files.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("glint-mitsuba-features-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder for one test's files, removed when the test ends.
+fn scratch(name: &str) -> ScratchDir {
+    ScratchDir::new(&format!("mitsuba-features-{name}"))
 }
 
 fn write(path: &Path, text: &str) {

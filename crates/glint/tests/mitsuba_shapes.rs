@@ -1,19 +1,19 @@
 //! Mitsuba's cylinder, shapegroup/instance, orthographic sensor, crop windows and projected
 //! lights: what the reader makes of them, and the built world's geometry.
 
+mod common;
+
+use common::scratch::ScratchDir;
 use glint::build::{build, BuildOptions};
 use glint::camera::{CropWindow, Projection};
 use glint::describe::{Geometry, LightKind, SceneDesc, TextureDesc};
 use glint::formats::mitsuba::read_str;
 use glint::lights::Light;
 use glint::math::{rgb, vec3, Ray, Rgb, Vec3};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("glint-mitsuba-shapes-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> ScratchDir {
+    ScratchDir::new(&format!("mitsuba-shapes-{name}"))
 }
 
 fn read(dir: &Path, body: &str) -> Result<SceneDesc, String> {

@@ -5,12 +5,16 @@
 mod common;
 
 use common::load::load;
+use common::scratch::ScratchDir;
 use glint::describe::{MaterialModel, TextureDesc};
 use std::path::{Path, PathBuf};
 
-fn write(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("glint-principled-blend-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// A folder for one test's files: tests run in parallel, so each needs its own.
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new(&format!("principled-blend-{test}"))
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
     p
@@ -23,8 +27,8 @@ fn scene_with(bsdf: &str) -> String {
     format!("<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"sphere\">\n{bsdf}\n</shape>\n</scene>\n")
 }
 
-fn error_of(name: &str, text: &str) -> String {
-    let p = write(name, text);
+fn error_of(dir: &Path, name: &str, text: &str) -> String {
+    let p = write(dir, name, text);
     match load(&p, &[], None) {
         Ok(_) => panic!("{name} loaded but should not"),
         Err(e) => {
@@ -36,41 +40,43 @@ fn error_of(name: &str, text: &str) -> String {
 
 #[test]
 fn a_blend_needs_two_bsdfs_and_a_weight() {
+    let dir = scratch("blend-arity");
     let one = scene_with(
         "<bsdf type=\"blendbsdf\">\n<float name=\"weight\" value=\"0.5\"/>\n<bsdf type=\"diffuse\"/>\n</bsdf>",
     );
-    let e = error_of("one.xml", &one);
+    let e = error_of(&dir, "one.xml", &one);
     assert!(e.contains("one.xml:5:") && e.contains("two nested BSDFs, found 1"), "{e}");
     let three = scene_with(
         "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/>\n<bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/>\n<bsdf type=\"conductor\"/></bsdf>",
     );
-    let e = error_of("three.xml", &three);
+    let e = error_of(&dir, "three.xml", &three);
     assert!(e.contains("three.xml:7:") && e.contains("more than two"), "{e}");
     let no_weight = scene_with("<bsdf type=\"blendbsdf\">\n<bsdf type=\"diffuse\"/><bsdf type=\"conductor\"/></bsdf>");
-    let e = error_of("noweight.xml", &no_weight);
+    let e = error_of(&dir, "noweight.xml", &no_weight);
     assert!(e.contains("noweight.xml:5:") && e.contains("'weight'"), "{e}");
 }
 
 #[test]
 fn principled_rejects_eta_with_specular_and_values_out_of_range() {
+    let dir = scratch("principled-ranges");
     let both = scene_with(
         "<bsdf type=\"principled\">\n<float name=\"eta\" value=\"1.5\"/><float name=\"specular\" value=\"0.5\"/></bsdf>",
     );
-    assert!(error_of("both.xml", &both).contains("either 'eta' or 'specular'"));
+    assert!(error_of(&dir, "both.xml", &both).contains("either 'eta' or 'specular'"));
     let aniso = scene_with("<bsdf type=\"principled\">\n<float name=\"anisotropic\" value=\"2\"/></bsdf>");
-    let e = error_of("aniso.xml", &aniso);
+    let e = error_of(&dir, "aniso.xml", &aniso);
     assert!(e.contains("aniso.xml:5:") && e.contains("anisotropic") && e.contains("[0, 1]"), "{e}");
     let nan = scene_with("<bsdf type=\"principled\">\n<float name=\"roughness\" value=\"nan\"/></bsdf>");
-    error_of("nan.xml", &nan);
+    error_of(&dir, "nan.xml", &nan);
     // An unsupported feature inside a blend is reported, with the blend's other errors.
     let nested = scene_with(
         "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/>\n<bsdf type=\"velvet\"/><bsdf type=\"diffuse\"/></bsdf>",
     );
-    assert!(error_of("nested.xml", &nested).contains("nested.xml:6:"));
+    assert!(error_of(&dir, "nested.xml", &nested).contains("nested.xml:6:"));
 }
 
-fn mitsuba_model(bsdf: &str) -> MaterialModel {
-    let p = write("model.xml", &scene_with(bsdf));
+fn mitsuba_model(dir: &Path, bsdf: &str) -> MaterialModel {
+    let p = write(dir, "model.xml", &scene_with(bsdf));
     let desc = glint::formats::mitsuba::read(&p, &[]).unwrap();
     desc.materials[0].model.clone()
 }
@@ -88,7 +94,9 @@ fn json_model(material: &str) -> MaterialModel {
 
 #[test]
 fn json_and_mitsuba_describe_the_same_principled_material() {
+    let dir = scratch("same-principled");
     let m = mitsuba_model(
+        &dir,
         r#"<bsdf type="principled"><rgb name="base_color" value="0.2, 0.4, 0.6"/>
            <float name="metallic" value="0.3"/><float name="specular" value="0.7"/>
            <float name="clearcoat" value="0.5"/></bsdf>"#,
@@ -101,7 +109,9 @@ fn json_and_mitsuba_describe_the_same_principled_material() {
 
 #[test]
 fn json_and_mitsuba_describe_the_same_blend() {
+    let dir = scratch("same-blend");
     let m = mitsuba_model(
+        &dir,
         r#"<bsdf type="blendbsdf"><float name="weight" value="0.25"/>
            <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.3"/></bsdf></bsdf>
            <bsdf type="principled"/></bsdf>"#,

@@ -6,15 +6,13 @@
 mod common;
 
 use common::load::load;
+use common::scratch::ScratchDir;
 use glint::io::Image;
 use glint::render::{render, Silent};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("glint-surface-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> ScratchDir {
+    ScratchDir::new(&format!("surface-{name}"))
 }
 
 fn render_xml(dir: &Path, name: &str, xml: &str) -> Image {

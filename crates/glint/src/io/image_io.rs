@@ -265,9 +265,19 @@ pub fn read_pfm_bytes(data: &[u8], path: &Path) -> Result<Image, String> {
 mod tests {
     use super::*;
 
+    /// Removes a test's scratch folder when dropped, so a failing test leaves nothing behind.
+    struct RemoveOnDrop(std::path::PathBuf);
+
+    impl Drop for RemoveOnDrop {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
     #[test]
     fn exr_and_pfm_round_trip_exactly() {
         let dir = std::env::temp_dir().join(format!("glint-io-{}", std::process::id()));
+        let _remove_dir = RemoveOnDrop(dir.clone());
         std::fs::create_dir_all(&dir).unwrap();
         let mut img = Image::new(7, 5);
         for (i, p) in img.pixels.iter_mut().enumerate() {
@@ -278,7 +288,6 @@ mod tests {
             write_image(&img, &path).unwrap();
             assert_eq!(read_image(&path).unwrap(), img, "{ext}");
         }
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

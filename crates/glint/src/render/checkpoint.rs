@@ -266,6 +266,15 @@ mod tests {
     use crate::math::Rgb;
     use crate::render::film::{to_fixed, TileSums};
 
+    /// Removes a test's scratch folder when dropped, so a failing test leaves nothing behind.
+    struct RemoveOnDrop(std::path::PathBuf);
+
+    impl Drop for RemoveOnDrop {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
     fn sample_film() -> Film {
         let region = Rect { x0: 1, y0: 2, x1: 5, y1: 4 };
         let mut f = Film::new(6, 5, region, 4, 10, &[Aov::Depth, Aov::Variance, Aov::Normal]).unwrap();
@@ -291,6 +300,7 @@ mod tests {
     #[test]
     fn round_trip_through_a_file() {
         let dir = std::env::temp_dir().join(format!("glint-checkpoint-{}", std::process::id()));
+        let _remove_dir = RemoveOnDrop(dir.clone());
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("film.glf");
         let film = sample_film();
@@ -300,7 +310,6 @@ mod tests {
         assert_eq!(m, meta());
         // Only the film itself is left in the folder (the temporary file was renamed).
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

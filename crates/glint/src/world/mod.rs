@@ -139,10 +139,8 @@ impl World {
     /// Sets the flags that say which materials the scene has; called whenever they change.
     pub(crate) fn update_material_flags(&mut self) {
         self.has_masks = self.materials.iter().any(Material::is_masked);
-        self.has_passage_materials = self
-            .materials
-            .iter()
-            .any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }));
+        self.has_passage_materials =
+            self.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }));
     }
 
     /// The share of next-event light choices made by power under `LightSelection::Power`; the

@@ -5,4 +5,5 @@ pub mod analytic;
 pub mod bsdf_check;
 pub mod load;
 pub mod scenes;
+pub mod scratch;
 pub mod stats;
