@@ -472,6 +472,7 @@ impl WorldBuilder {
             bvh_build_seconds: 0.0,
             has_masks: false,
             has_passage_materials: false,
+            prefetch_hits: false,
             media: self.media,
             camera_medium: self.camera_medium,
         };

@@ -71,9 +71,25 @@ pub fn li_batch(
             stepping.push(Stepping { path: i, hit });
         }
         order.sort_unstable();
-        for &o in &order {
-            let st = &stepping[o as u32 as usize];
-            paths[st.path].step(s, scene, st.hit, &mut samples[st.path].sampler, c);
+        if scene.prefetch_hits {
+            // The hit data of the paths a step or two ahead is fetched while this one steps:
+            // on large meshes the vertices a hit reads are cache misses (no bits change).
+            let ahead = |k: usize| order.get(k).and_then(|&o| stepping[o as u32 as usize].hit.as_ref());
+            for (k, &o) in order.iter().enumerate() {
+                if let Some(h) = ahead(k + 2) {
+                    scene.prefetch_hit_indices(h);
+                }
+                if let Some(h) = ahead(k + 1) {
+                    scene.prefetch_hit_vertices(h);
+                }
+                let st = &stepping[o as u32 as usize];
+                paths[st.path].step(s, scene, st.hit, &mut samples[st.path].sampler, c);
+            }
+        } else {
+            for &o in &order {
+                let st = &stepping[o as u32 as usize];
+                paths[st.path].step(s, scene, st.hit, &mut samples[st.path].sampler, c);
+            }
         }
 
         shadowed.clear();

@@ -7,7 +7,7 @@
 //! costs its memory once. Traversal returns a cheap [`Hit`]; the full
 //! [`SurfaceInteraction`] is computed only for the hit that is shaded.
 
-use crate::accel::{BvhSplit, FlatMesh, TopLevelBvh};
+use crate::accel::{prefetch, BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{Cylinder, SdfGrid, Sphere, TriangleMesh};
 use crate::lights::{Light, LightSelection};
@@ -47,6 +47,11 @@ pub enum BatchTraversal {
     /// Several traversals in flight per thread, interleaved ([`World::intersect_batch`]).
     Interleaved,
 }
+
+/// Mesh data (positions, normals, uvs, indices) above which the wavefront prefetches hit
+/// data: about a core's L2. Below it the prefetches cost 1% on the Cornell box and gain
+/// nothing; above it they gained 4% on the 100k-triangle dragon (BENCHMARKS.md).
+const PREFETCH_HITS_ABOVE_BYTES: usize = 1 << 20;
 
 /// What traversal returns: enough to find the hit again, nothing more.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -106,6 +111,9 @@ pub struct World {
     /// Some material is a passage for volpath (`null`, `thindielectric`): its shadow rays
     /// then look past what they hit. Kept here so that no path scans the materials.
     pub(crate) has_passage_materials: bool,
+    /// The meshes are large enough that the hit data `interaction` reads is often out of
+    /// cache: the wavefront then prefetches it (on small scenes that only costs time).
+    pub(crate) prefetch_hits: bool,
     /// Participating media, indexed by [`Instance::media`] and `camera_medium`.
     pub(crate) media: Vec<Medium>,
     /// The medium the camera sits in.
@@ -133,6 +141,16 @@ impl World {
         self.top = TopLevelBvh::build_flattening(&boxes, self.bvh_split, &flat);
         self.bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
         self.update_material_flags();
+        let mesh_bytes: usize = self
+            .meshes
+            .iter()
+            .map(|m| {
+                let vertex =
+                    std::mem::size_of::<Vec3>() * (1 + m.normals.is_some() as usize) + 8 * m.uvs.is_some() as usize;
+                m.positions.len() * vertex + m.indices.len() * std::mem::size_of::<[u32; 3]>()
+            })
+            .sum();
+        self.prefetch_hits = mesh_bytes > PREFETCH_HITS_ABOVE_BYTES;
         self.set_light_selection(selection);
     }
 
@@ -404,6 +422,51 @@ impl World {
         match si.light.and_then(|l| self.lights.get(l as usize)) {
             Some(light) => light.emitted(&self.texture_point(si), si.ng, wi),
             None => Rgb::BLACK,
+        }
+    }
+
+    /// Whether the wavefront prefetches hit data: the meshes are larger than about a core's
+    /// L2 cache (see `PREFETCH_HITS_ABOVE_BYTES`).
+    pub fn prefetches_hits(&self) -> bool {
+        self.prefetch_hits
+    }
+
+    /// First of two prefetches for [`World::interaction`] of `hit`: starts loading the hit
+    /// triangle's vertex indices. Changes nothing; the wavefront calls it a few paths ahead.
+    #[inline]
+    pub(crate) fn prefetch_hit_indices(&self, hit: &Hit) {
+        if let Some(mesh) = self.hit_mesh(hit) {
+            if let Some(ix) = mesh.indices.get(hit.prim as usize) {
+                prefetch(ix);
+            }
+        }
+    }
+
+    /// Second prefetch for `hit`, once its indices are (likely) in cache: starts loading the
+    /// vertices' positions, normals and uvs, which `interaction` reads at random places of
+    /// large meshes (the wait for them was half of its time on the 100k-triangle dragon).
+    #[inline]
+    pub(crate) fn prefetch_hit_vertices(&self, hit: &Hit) {
+        let Some(mesh) = self.hit_mesh(hit) else { return };
+        let Some(&ix) = mesh.indices.get(hit.prim as usize) else { return };
+        for i in ix {
+            if let Some(p) = mesh.positions.get(i as usize) {
+                prefetch(p);
+            }
+            if let Some(n) = mesh.normals.as_ref().and_then(|n| n.get(i as usize)) {
+                prefetch(n);
+            }
+            if let Some(t) = mesh.uvs.as_ref().and_then(|t| t.get(i as usize)) {
+                prefetch(t);
+            }
+        }
+    }
+
+    #[inline]
+    fn hit_mesh(&self, hit: &Hit) -> Option<&TriangleMesh> {
+        match self.instances.get(hit.instance as usize)?.shape {
+            ShapeRef::Mesh(m) => self.meshes.get(m as usize).map(|m| &**m),
+            _ => None,
         }
     }
 
