@@ -11,8 +11,9 @@
 //! lobe of a thin dielectric) are passages, not scattering events: paths go on through them
 //! without counting depth, and shadow rays pass through them, attenuated by every medium
 //! they cross. A masked surface (`mask`) is a passage with probability 1 - opacity: paths
-//! pass it at random, as in `path`, and shadow rays carry its 1 - opacity. A shape that bounds media switches the ray's medium to the one on the side
-//! the ray leaves to. Surfaces without media behave exactly as in `path`.
+//! pass it at random, as in `path`, and shadow rays carry its 1 - opacity. A shape that
+//! bounds media switches the ray's medium to the one on the side the ray leaves to.
+//! Surfaces without media behave exactly as in `path`.
 //!
 //! Depth counts scattering events (in media and at surfaces, not passages), as Mitsuba's
 //! `max_depth` does: 1 shows emitters seen directly (through any passages and media), 2

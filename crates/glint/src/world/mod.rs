@@ -49,8 +49,8 @@ pub enum BatchTraversal {
 }
 
 /// Mesh data (positions, normals, uvs, indices) above which the wavefront prefetches hit
-/// data: about a core's L2. Below it the prefetches cost 1% on the Cornell box and gain
-/// nothing; above it they gained 4% on the 100k-triangle dragon (BENCHMARKS.md).
+/// data: about a core's L2. Below it the prefetches cost 2% on the Cornell box and gain
+/// nothing; above it they gained 2 to 4% on the 100k-triangle dragon (BENCHMARKS.md).
 const PREFETCH_HITS_ABOVE_BYTES: usize = 1 << 20;
 
 /// What traversal returns: enough to find the hit again, nothing more.
@@ -444,7 +444,7 @@ impl World {
 
     /// Second prefetch for `hit`, once its indices are (likely) in cache: starts loading the
     /// vertices' positions, normals and uvs, which `interaction` reads at random places of
-    /// large meshes (the wait for them was half of its time on the 100k-triangle dragon).
+    /// large meshes (the wait for them was about 40% of its time on the 100k-triangle dragon).
     #[inline]
     pub(crate) fn prefetch_hit_vertices(&self, hit: &Hit) {
         let Some(mesh) = self.hit_mesh(hit) else { return };
