@@ -55,20 +55,12 @@ struct Lane<L, E> {
 /// Asks the CPU to start loading node `i` (all of its cache lines) now.
 #[inline(always)]
 fn prefetch_node<const W: usize>(nodes: &[WideNode<W>], i: u32) {
-    #[cfg(target_arch = "x86_64")]
     if let Some(node) = nodes.get(i as usize) {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let p = (node as *const WideNode<W>).cast::<i8>();
-        let mut offset = 0;
-        while offset < std::mem::size_of::<WideNode<W>>() {
-            // SAFETY: `offset` is inside the node, so the pointer is in bounds of one
-            // allocation; a prefetch never faults and writes nothing. SSE is x86-64 baseline.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.add(offset)) };
-            offset += 64;
+        let p = (node as *const WideNode<W>).cast::<u8>();
+        for offset in (0..std::mem::size_of::<WideNode<W>>()).step_by(64) {
+            super::prefetch_address(p.wrapping_add(offset));
         }
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (nodes, i);
 }
 
 /// One node visit of a traversal kind. A trait with `#[inline(always)]` implementations, not

@@ -25,16 +25,22 @@ pub use wide::{WideBvh, WideStats};
 pub use wide_mesh::TriangleWideBvh;
 
 /// Asks the CPU to start loading the cache line that holds `value`, so that a later read of
-/// it waits less. Changes nothing else; a no-op off x86-64.
+/// it waits less. Changes nothing else.
 #[inline(always)]
 pub fn prefetch<T>(value: &T) {
+    prefetch_address((value as *const T).cast());
+}
+
+/// [`prefetch`] of any address, valid or not; a no-op off x86-64.
+#[inline(always)]
+pub(crate) fn prefetch_address(p: *const u8) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        // SAFETY: the pointer comes from a reference, so it is valid; a prefetch never faults
-        // and writes nothing, whatever the address. SSE is part of the x86-64 baseline.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>((value as *const T).cast::<i8>()) };
+        // SAFETY: a prefetch never faults and writes nothing, whatever the address (null,
+        // dangling, unmapped). SSE is part of the x86-64 baseline.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.cast::<i8>()) };
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
+    let _ = p;
 }
