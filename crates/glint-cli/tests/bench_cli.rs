@@ -10,6 +10,10 @@ use glint::math::{Ray, Vec3};
 use std::path::PathBuf;
 use std::process::Command;
 
+/// The library's scratch folders for tests (removed when dropped, even on a panic).
+#[path = "../../glint/tests/common/scratch.rs"]
+mod scratch;
+
 fn glint(args: &[&str]) -> String {
     let o = Command::new(env!("CARGO_BIN_EXE_glint")).args(args).output().unwrap();
     assert!(o.status.success(), "glint {args:?} failed: {}", String::from_utf8_lossy(&o.stderr));
@@ -20,20 +24,9 @@ fn floats(path: &PathBuf) -> Vec<f32> {
     std::fs::read(path).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
 }
 
-/// Removes the test's scratch folder when dropped, so a failing test leaves nothing behind.
-struct RemoveOnDrop(PathBuf);
-
-impl Drop for RemoveOnDrop {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 #[test]
 fn bench_json_is_well_formed_and_hits_match_the_reference() {
-    let dir = std::env::temp_dir().join(format!("glint-bench-cli-{}", std::process::id()));
-    let _remove_dir = RemoveOnDrop(dir.clone());
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::ScratchDir::new("bench-cli");
     // A small closed-ish mesh: a bumpy grid plus a tetrahedron floating above it.
     let mut obj = String::new();
     let n = 24;

@@ -33,4 +33,10 @@ pub mod sampling;
 pub mod session;
 pub mod world;
 
+/// Scratch folders for the unit tests that write files: the integration tests' helper, so
+/// that there is one.
+#[cfg(test)]
+#[path = "../tests/common/scratch.rs"]
+mod scratch;
+
 pub use error::{Error, SourceLoc};

@@ -265,20 +265,9 @@ pub fn read_pfm_bytes(data: &[u8], path: &Path) -> Result<Image, String> {
 mod tests {
     use super::*;
 
-    /// Removes a test's scratch folder when dropped, so a failing test leaves nothing behind.
-    struct RemoveOnDrop(std::path::PathBuf);
-
-    impl Drop for RemoveOnDrop {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-
     #[test]
     fn exr_and_pfm_round_trip_exactly() {
-        let dir = std::env::temp_dir().join(format!("glint-io-{}", std::process::id()));
-        let _remove_dir = RemoveOnDrop(dir.clone());
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::ScratchDir::new("io");
         let mut img = Image::new(7, 5);
         for (i, p) in img.pixels.iter_mut().enumerate() {
             *p = Rgb { r: i as f32 * 0.37, g: -(i as f32), b: 1e-3 * i as f32 };

@@ -266,15 +266,6 @@ mod tests {
     use crate::math::Rgb;
     use crate::render::film::{to_fixed, TileSums};
 
-    /// Removes a test's scratch folder when dropped, so a failing test leaves nothing behind.
-    struct RemoveOnDrop(std::path::PathBuf);
-
-    impl Drop for RemoveOnDrop {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-
     fn sample_film() -> Film {
         let region = Rect { x0: 1, y0: 2, x1: 5, y1: 4 };
         let mut f = Film::new(6, 5, region, 4, 10, &[Aov::Depth, Aov::Variance, Aov::Normal]).unwrap();
@@ -299,9 +290,7 @@ mod tests {
 
     #[test]
     fn round_trip_through_a_file() {
-        let dir = std::env::temp_dir().join(format!("glint-checkpoint-{}", std::process::id()));
-        let _remove_dir = RemoveOnDrop(dir.clone());
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::ScratchDir::new("checkpoint");
         let path = dir.join("film.glf");
         let film = sample_film();
         write_film(&path, &film, &meta()).unwrap();

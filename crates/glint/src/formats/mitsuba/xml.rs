@@ -406,15 +406,6 @@ fn snake_case(s: &str) -> String {
 mod tests {
     use super::*;
 
-    /// Removes a test's scratch folder when dropped, so a failing test leaves nothing behind.
-    struct RemoveOnDrop(std::path::PathBuf);
-
-    impl Drop for RemoveOnDrop {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-
     #[test]
     fn old_parameter_names_become_snake_case() {
         assert_eq!(snake_case("intIOR"), "int_ior");
@@ -428,9 +419,7 @@ mod tests {
         let text = r#"<scene version="0.6.0"><default name="d" value="3"/>
             <shape type="sphere"><transform name="toWorld"><lookAt origin="0,0,1" target="0,0,0" up="0,1,0"/></transform>
             <float name="radius" value="$d"/></shape></scene>"#;
-        let dir = std::env::temp_dir().join(format!("glint-xml-v06-{}", std::process::id()));
-        let _remove_dir = RemoveOnDrop(dir.clone());
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::ScratchDir::new("xml-v06");
         let p = dir.join("old.xml");
         std::fs::write(&p, text).unwrap();
         let root = load_tree(&p, &[]).unwrap().root;
@@ -551,9 +540,7 @@ mod tests {
         assert_eq!(ids, ["y", "x"]);
         assert_eq!(tree.included.len(), 2);
         // A file on disk is not visible through a memory source.
-        let dir = std::env::temp_dir().join(format!("glint-xml-mem-{}", std::process::id()));
-        let _remove_dir = RemoveOnDrop(dir.clone());
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::ScratchDir::new("xml-mem");
         let disk = dir.join("disk.xml");
         std::fs::write(&disk, "<bsdf type=\"diffuse\"/>").unwrap();
         let text = format!(r#"<scene version="3.0.0"><include filename="{}"/></scene>"#, disk.display());
