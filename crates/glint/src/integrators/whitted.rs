@@ -1,14 +1,17 @@
 //! Whitted-style ray tracing (the paper's section 3.1): direct light from every light with
 //! hard shadows (one sample per area light per camera sample), perfect mirror reflection,
 //! and refraction weighted by the exact dielectric Fresnel term with total internal
-//! reflection, up to a maximum depth. Depth 1 traces camera and shadow rays only.
+//! reflection, up to a maximum depth. Depth 1 traces camera and shadow rays only. Masked
+//! surfaces (cut-outs) let rays through as in the other integrators: a traced ray passes
+//! with probability 1 - opacity, a shadow ray carries the product of 1 - opacity.
 
+use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
 use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, Bsdf};
 use crate::describe::WhittedSettings;
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
-use crate::world::World;
+use crate::world::{SurfaceInteraction, World};
 
 pub fn li(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters) -> Rgb {
     // The recursion of the paper, run on an explicit stack so that any `max_depth` fits:
@@ -99,19 +102,11 @@ enum Node {
 
 /// Everything the recursive form did at one hit before (and without) recursing.
 fn shade(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Node {
-    c.rays += 1;
-    let Some(hit) = scene.intersect(ray) else {
-        if scene.environment_lights.is_empty() {
-            return Node::Done(Rgb::from_array(s.background));
-        }
-        return Node::Done(
-            scene.environment_lights.iter().fold(Rgb::BLACK, |a, &i| a + scene.lights[i as usize].environment(ray.dir)),
-        );
-    };
-    let si = scene.interaction(ray, &hit);
-    let wo_world = -ray.dir;
     let mut l = Rgb::BLACK;
-    l += scene.emitted(&si, ray.dir);
+    let Some(si) = scattering_hit(scene, ray, rng, c, &mut l) else {
+        return Node::Done(escaped(s, scene, ray, l));
+    };
+    let wo_world = -ray.dir;
     let (bsdf, frame) = shading(scene, &si, wo_world);
     let wo = frame.to_local(wo_world);
     let can_recurse = depth < s.max_depth;
@@ -154,13 +149,53 @@ fn shade(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
                     continue;
                 }
                 c.shadow_rays += 1;
-                if !scene.occluded(&shadow_ray(&si, ls.wi, ls.dist)) {
-                    l += f * ls.radiance / ls.pdf;
+                // Exactly 0 or 1 where no mask is on the way, and times 1 keeps the bits.
+                let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
+                if visible > 0.0 {
+                    l += f * ls.radiance / ls.pdf * visible;
                 }
             }
         }
     }
     Node::Done(l)
+}
+
+/// The first surface along `ray` that scatters it, after adding to `l` what the surfaces on
+/// the way emit: a masked surface lets the ray through unscattered with probability
+/// 1 - opacity (one random number per masked surface met; passing is not a bounce). `None`
+/// when the ray escapes.
+fn scattering_hit(
+    scene: &World,
+    ray: &Ray,
+    rng: &mut Sampler,
+    c: &mut Counters,
+    l: &mut Rgb,
+) -> Option<SurfaceInteraction> {
+    let mut ray = *ray;
+    let mut passes = 0;
+    loop {
+        c.rays += 1;
+        let hit = scene.intersect(&ray)?;
+        let si = scene.interaction(&ray, &hit);
+        *l += scene.emitted(&si, ray.dir);
+        if scene.has_masks && passes < MAX_MASK_PASSES {
+            let o = opacity(scene, &si);
+            if o < 1.0 && rng.next_f32() >= o {
+                passes += 1;
+                ray = spawn_ray(&si, ray.dir);
+                continue;
+            }
+        }
+        return Some(si);
+    }
+}
+
+/// What an escaping ray brings, added to `l`: the environment lights, or the background.
+fn escaped(s: &WhittedSettings, scene: &World, ray: &Ray, l: Rgb) -> Rgb {
+    if scene.environment_lights.is_empty() {
+        return l + Rgb::from_array(s.background);
+    }
+    scene.environment_lights.iter().fold(l, |a, &i| a + scene.lights[i as usize].environment(ray.dir))
 }
 
 #[cfg(test)]
@@ -183,20 +218,11 @@ mod tests {
     }
 
     fn trace(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &mut Counters, depth: u32) -> Rgb {
-        c.rays += 1;
-        let Some(hit) = scene.intersect(ray) else {
-            if scene.environment_lights.is_empty() {
-                return Rgb::from_array(s.background);
-            }
-            return scene
-                .environment_lights
-                .iter()
-                .fold(Rgb::BLACK, |a, &i| a + scene.lights[i as usize].environment(ray.dir));
-        };
-        let si = scene.interaction(ray, &hit);
-        let wo_world = -ray.dir;
         let mut l = Rgb::BLACK;
-        l += scene.emitted(&si, ray.dir);
+        let Some(si) = scattering_hit(scene, ray, rng, c, &mut l) else {
+            return escaped(s, scene, ray, l);
+        };
+        let wo_world = -ray.dir;
         let (bsdf, frame) = shading(scene, &si, wo_world);
         let wo = frame.to_local(wo_world);
         let can_recurse = depth < s.max_depth;
@@ -237,8 +263,9 @@ mod tests {
                         continue;
                     }
                     c.shadow_rays += 1;
-                    if !scene.occluded(&shadow_ray(&si, ls.wi, ls.dist)) {
-                        l += f * ls.radiance / ls.pdf;
+                    let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
+                    if visible > 0.0 {
+                        l += f * ls.radiance / ls.pdf * visible;
                     }
                 }
             }
@@ -316,6 +343,91 @@ mod tests {
             assert!(iterative == recursive, "depth {max_depth}: images differ");
             assert!(iterative.iter().any(|&b| b != 0), "depth {max_depth}: black image");
         }
+    }
+
+    /// A diffuse floor at z = 0 lit by a small downward light at `light_z`, a black sheet of
+    /// opacity 0.5 at `sheet_z` (if any), seen from `eye_z` straight above.
+    fn sheet_scene(sheet_z: Option<f32>, eye_z: f32, light_z: f32) -> World {
+        let mut b = WorldBuilder::new(BvhSplit::Sah);
+        let floor = b.add_material(Material::new(
+            "floor",
+            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },
+            true,
+        ));
+        // Counter-clockwise from above (normal +z), the light's the other way round.
+        let quad = |b: &mut WorldBuilder, a: f32, z: f32, m: u32, e: Option<AreaEmission>| {
+            let mut p = [vec3(-a, -a, z), vec3(a, -a, z), vec3(a, a, z), vec3(-a, a, z)];
+            if e.is_some() {
+                p.reverse();
+            }
+            let mesh = Arc::new(quad_mesh(p, BvhSplit::Sah));
+            b.add_mesh_instance(&mesh, &Transform::IDENTITY, false, m, e, false).unwrap();
+        };
+        quad(&mut b, 20.0, 0.0, floor, None);
+        let light = b.black_material();
+        quad(&mut b, 0.3, light_z, light, Some(AreaEmission::constant(Rgb::splat(20.0))));
+        if let Some(z) = sheet_z {
+            let black = MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::BLACK) };
+            let sheet = b.add_material(Material::new(
+                "sheet",
+                MaterialKind::Mask { opacity: Texture::Constant(Rgb::splat(0.5)), nested: Box::new(black) },
+                true,
+            ));
+            quad(&mut b, 20.0, z, sheet, None);
+        }
+        let to_world = Transform::look_at(vec3(0.0, 0.0, eye_z), vec3(0.0, 0.01, 0.0), Vec3::Y).unwrap();
+        b.finish(Camera::new(to_world, 12, 12, 30.0, FovAxis::Y), LightSelection::Power).unwrap()
+    }
+
+    /// Every sample's radiance (mean of the channels), `spp` samples per pixel.
+    fn samples(scene: &World, spp: u32) -> Vec<f64> {
+        let s = WhittedSettings { max_depth: 4, background: [0.0; 3] };
+        let mut c = Counters::default();
+        let mut out = Vec::new();
+        for y in 0..scene.camera.height {
+            for x in 0..scene.camera.width {
+                let pixel = (y * scene.camera.width + x) as u64;
+                for sample in 0..spp {
+                    let mut rng = Sampler::new(SamplerKind::Independent, 3, pixel, sample);
+                    let ray = scene.camera.generate_ray(x as f32 + 0.5, y as f32 + 0.5, [0.5; 2]);
+                    let l = li(&s, scene, &ray, &mut rng, &mut c);
+                    out.push(l.to_array().iter().map(|&v| v as f64).sum::<f64>() / 3.0);
+                }
+            }
+        }
+        out
+    }
+
+    fn mean_and_error(v: &[f64]) -> (f64, f64) {
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+        (mean, (var / n).sqrt())
+    }
+
+    #[test]
+    fn a_half_opaque_sheet_halves_the_light_its_shadow_rays_cross() {
+        // The camera under the sheet: shadow rays from the floor cross it and carry its
+        // transmittance 0.5, so every sample is exactly half (the same light points are
+        // sampled with and without the sheet).
+        let plain = samples(&sheet_scene(None, 0.5, 2.0), 4);
+        let masked = samples(&sheet_scene(Some(1.0), 0.5, 2.0), 4);
+        assert!(plain.iter().any(|&v| v > 0.01), "the floor is lit");
+        for (p, q) in plain.iter().zip(&masked) {
+            assert!((q - 0.5 * p).abs() <= 1e-6 * p.abs() + 1e-9, "{q} is not half of {p}");
+        }
+    }
+
+    #[test]
+    fn a_half_opaque_sheet_halves_what_the_camera_sees_through_it() {
+        // The light under the sheet, the camera above: camera rays pass with probability 0.5
+        // and the black sheet returns nothing when they do not. Before masks were read here
+        // the sheet was opaque and the image black.
+        let (a, ea) = mean_and_error(&samples(&sheet_scene(None, 3.0, 0.8), 64));
+        let (b, eb) = mean_and_error(&samples(&sheet_scene(Some(1.5), 3.0, 0.8), 64));
+        assert!(a > 0.01, "the floor is lit: {a}");
+        let tol = 4.0 * (eb * eb + 0.25 * ea * ea).sqrt();
+        assert!((b - 0.5 * a).abs() < tol, "{b} vs half of {a} (tolerance {tol})");
     }
 
     #[test]
