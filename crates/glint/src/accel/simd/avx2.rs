@@ -18,30 +18,12 @@ unsafe impl Isa for Avx2 {
             return super::Sse::node(node, r, t_max, dist);
         }
         let mut mask = 0u32;
-        let o = [_mm256_set1_ps(r.o[0]), _mm256_set1_ps(r.o[1]), _mm256_set1_ps(r.o[2])];
-        let inv = [_mm256_set1_ps(r.inv[0]), _mm256_set1_ps(r.inv[1]), _mm256_set1_ps(r.inv[2])];
-        let (t_min, t_max, scale) = (_mm256_set1_ps(r.t_min), _mm256_set1_ps(t_max), _mm256_set1_ps(FAR_SCALE));
         for c in 0..W / 8 {
-            // SAFETY: `row < 6` (the contract of `Isa::node`) and `8 * c + 8 <= W`; the node
-            // is 32-byte aligned and each row is `W * 4` bytes, a multiple of 32, as the
-            // aligned load needs.
-            let slab = |row: usize, a: usize| {
-                _mm256_mul_ps(
-                    _mm256_sub_ps(_mm256_load_ps(node.bounds.get_unchecked(row).as_ptr().add(8 * c)), o[a]),
-                    inv[a],
-                )
-            };
-            let t_near = _mm256_max_ps(
-                slab(r.near[0], 0),
-                _mm256_max_ps(slab(r.near[1], 1), _mm256_max_ps(slab(r.near[2], 2), t_min)),
-            );
-            let t_far = _mm256_min_ps(
-                slab(r.far[0], 0),
-                _mm256_min_ps(slab(r.far[1], 1), _mm256_min_ps(slab(r.far[2], 2), t_max)),
-            );
+            // SAFETY: this path runs only with AVX2; `8 * c + 8 <= W` (so the store of eight
+            // distances stays in `dist` too), and the rows are the caller's (`Isa::node`).
+            let (t_near, t_far) = slabs8(node, r, t_max, c);
             _mm256_storeu_ps(dist.as_mut_ptr().add(8 * c), t_near);
-            mask |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, scale))) as u32)
-                << (8 * c);
+            mask |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far)) as u32) << (8 * c);
         }
         mask
     }
@@ -55,6 +37,34 @@ unsafe impl Isa for Avx2 {
     unsafe fn tri8(lo: &Tri4, hi: &Tri4, r: &TriRay, t_min: f32, t_max: f32) -> TriHits<8> {
         tri8_avx2(lo, hi, r, t_min, t_max)
     }
+}
+
+/// Entry and scaled exit distances of children `8 * c..8 * c + 8` of a node (the slab test
+/// of every path, eight lanes at once): a child is hit where entry <= exit. Shared by the
+/// AVX2 and AVX-512 node tests, which differ only in how they read the comparison.
+///
+/// # Safety
+/// AVX2 must be available, `8 * c + 8 <= W`, and the rows `r.near`, `r.far` below 6 (the
+/// contract of `Isa::node`).
+#[inline(always)]
+pub(super) unsafe fn slabs8<const W: usize>(node: &WideNode<W>, r: &NodeRay, t_max: f32, c: usize) -> (__m256, __m256) {
+    let o = [_mm256_set1_ps(r.o[0]), _mm256_set1_ps(r.o[1]), _mm256_set1_ps(r.o[2])];
+    let inv = [_mm256_set1_ps(r.inv[0]), _mm256_set1_ps(r.inv[1]), _mm256_set1_ps(r.inv[2])];
+    // SAFETY: the caller's contract; the node is 32-byte aligned and each row is `W * 4`
+    // bytes, a multiple of 32, as the aligned load needs.
+    let slab = |row: usize, a: usize| {
+        _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds.get_unchecked(row).as_ptr().add(8 * c)), o[a]), inv[a])
+    };
+    // NaN slabs lose to the other operand (`maxps`/`minps`), as on every path.
+    let t_near = _mm256_max_ps(
+        slab(r.near[0], 0),
+        _mm256_max_ps(slab(r.near[1], 1), _mm256_max_ps(slab(r.near[2], 2), _mm256_set1_ps(r.t_min))),
+    );
+    let t_far = _mm256_min_ps(
+        slab(r.far[0], 0),
+        _mm256_min_ps(slab(r.far[1], 1), _mm256_min_ps(slab(r.far[2], 2), _mm256_set1_ps(t_max))),
+    );
+    (t_near, _mm256_mul_ps(t_far, _mm256_set1_ps(FAR_SCALE)))
 }
 
 /// The watertight test on two blocks at once, operation for operation as `tri4_sse` (and so

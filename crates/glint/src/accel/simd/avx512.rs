@@ -3,13 +3,14 @@
 //! path's, compiled with AVX-512 on: four blocks in one 16-lane test were measured 13 to 17%
 //! slower on closest hits than two blocks in one 8-lane test (BENCHMARKS.md, Sapphire Rapids).
 //!
-//! The node test is `Avx2::node`'s operations, lane for lane, with the mask-register form of
-//! the same comparison (`cmple`, LE_OQ), so the same bits.
+//! The node test is `Avx2::node`'s slab arithmetic (`avx2::slabs8`) with the mask-register
+//! form of the same comparison (`cmple`, LE_OQ), so the same bits.
 
+use super::avx2::slabs8;
 use super::sse::tri4_sse;
 use super::{Avx2, Isa};
 use crate::accel::tri4::{Tri4, Tri4Hits, TriHits, TriRay};
-use crate::accel::wide::{NodeRay, WideNode, FAR_SCALE};
+use crate::accel::wide::{NodeRay, WideNode};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy, Debug)]
@@ -21,24 +22,11 @@ unsafe impl Isa for Avx512 {
         if W != 8 {
             return Avx2::node(node, r, t_max, dist);
         }
-        let o = [_mm256_set1_ps(r.o[0]), _mm256_set1_ps(r.o[1]), _mm256_set1_ps(r.o[2])];
-        let inv = [_mm256_set1_ps(r.inv[0]), _mm256_set1_ps(r.inv[1]), _mm256_set1_ps(r.inv[2])];
-        // SAFETY: `row < 6` (the contract of `Isa::node`) and W = 8; the node is 32-byte
-        // aligned and each row is 32 bytes, as the aligned load needs.
-        let slab = |row: usize, a: usize| {
-            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.bounds.get_unchecked(row).as_ptr()), o[a]), inv[a])
-        };
-        // NaN slabs lose to the other operand (`maxps`/`minps`), as on every path.
-        let t_near = _mm256_max_ps(
-            slab(r.near[0], 0),
-            _mm256_max_ps(slab(r.near[1], 1), _mm256_max_ps(slab(r.near[2], 2), _mm256_set1_ps(r.t_min))),
-        );
-        let t_far = _mm256_min_ps(
-            slab(r.far[0], 0),
-            _mm256_min_ps(slab(r.far[1], 1), _mm256_min_ps(slab(r.far[2], 2), _mm256_set1_ps(t_max))),
-        );
+        // SAFETY: this path runs only where AVX2 is available too (`SimdPath::is_available`);
+        // W = 8, and the rows are the caller's (`Isa::node`).
+        let (t_near, t_far) = slabs8(node, r, t_max, 0);
         _mm256_storeu_ps(dist.as_mut_ptr(), t_near);
-        _mm256_cmp_ps_mask::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, _mm256_set1_ps(FAR_SCALE))) as u32
+        _mm256_cmp_ps_mask::<_CMP_LE_OQ>(t_near, t_far) as u32
     }
 
     #[inline(always)]
