@@ -10,7 +10,7 @@
 //! lights come out emitter_samples times too bright there; here every light sample counts
 //! 1/emitter_samples.
 
-use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
+use super::surface::{opacity, passes_mask, transmittance, MAX_MASK_PASSES};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::DirectSettings;
 use crate::math::{Ray, Rgb};
@@ -36,13 +36,10 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
         let si = scene.interaction(&ray, &hit);
         // Only reached when emitters are shown (`camera_hit` looks through them otherwise).
         l += scene.emitted(&si, ray.dir);
-        if scene.has_masks && passes < MAX_MASK_PASSES {
-            let o = opacity(scene, &si);
-            if o < 1.0 && rng.next_f32() >= o {
-                passes += 1;
-                camera_ray = spawn_ray(&si, ray.dir);
-                continue;
-            }
+        if passes_mask(scene, &si, passes, rng) {
+            passes += 1;
+            camera_ray = spawn_ray(&si, ray.dir);
+            continue;
         }
         break (ray, si);
     };

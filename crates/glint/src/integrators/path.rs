@@ -9,7 +9,7 @@
 //! reference); `path_batch` traces many paths' rays together. Both run the same steps in the
 //! same order, so a path's radiance is the same bits either way.
 
-use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
+use super::surface::{passes_mask, transmittance};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
 use crate::math::{Ray, Rgb, Vec3};
@@ -159,15 +159,12 @@ impl PathState {
         // A masked surface lets the path through unscattered with probability 1 - opacity.
         // Passing is not a bounce: depth, the MIS state and the previous vertex stay as
         // they were (shadow rays from that vertex crossed the surface the same way).
-        if scene.has_masks && self.mask_passes < MAX_MASK_PASSES {
-            let o = opacity(scene, &si);
-            if o < 1.0 && rng.next_f32() >= o {
-                self.mask_passes += 1;
-                self.depth -= 1;
-                self.ray = spawn_ray(&si, ray.dir);
-                self.tracing = true;
-                return;
-            }
+        if passes_mask(scene, &si, self.mask_passes, rng) {
+            self.mask_passes += 1;
+            self.depth -= 1;
+            self.ray = spawn_ray(&si, ray.dir);
+            self.tracing = true;
+            return;
         }
         if self.depth >= self.max_depth {
             return;

@@ -5,6 +5,7 @@ use super::Counters;
 use crate::bsdf::{flip_invalid, normal_map_frame, ShadedBsdf};
 use crate::materials::{Perturbation, TexturePoint};
 use crate::math::{offset_origin, Frame, Ray, Vec3};
+use crate::sampling::Sampler;
 use crate::world::{SurfaceInteraction, World};
 
 /// The most masked surfaces one ray passes through; a ray that meets more (a stack of
@@ -23,6 +24,18 @@ pub(crate) fn opacity(scene: &World, si: &SurfaceInteraction) -> f32 {
         return 1.0;
     }
     mat.opacity(&texture_point(scene, si))
+}
+
+/// Whether a ray that met the surface at `si` after `passes` earlier passes goes on through
+/// it unscattered: a masked surface lets it pass with probability 1 - opacity (one random
+/// number per masked surface met), up to [`MAX_MASK_PASSES`] times along one path segment.
+#[inline]
+pub(crate) fn passes_mask(scene: &World, si: &SurfaceInteraction, passes: u32, rng: &mut Sampler) -> bool {
+    if !scene.has_masks || passes >= MAX_MASK_PASSES {
+        return false;
+    }
+    let o = opacity(scene, si);
+    o < 1.0 && rng.next_f32() >= o
 }
 
 /// The fraction of light that gets along a shadow ray: 1 when nothing blocks it, 0 when an

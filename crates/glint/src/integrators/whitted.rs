@@ -5,7 +5,7 @@
 //! surfaces (cut-outs) let rays through as in the other integrators: a traced ray passes
 //! with probability 1 - opacity, a shadow ray carries the product of 1 - opacity.
 
-use super::surface::{opacity, transmittance, MAX_MASK_PASSES};
+use super::surface::{passes_mask, transmittance};
 use super::{shading, shadow_ray, spawn_ray, Counters};
 use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, Bsdf};
 use crate::describe::WhittedSettings;
@@ -178,13 +178,10 @@ fn scattering_hit(
         let hit = scene.intersect(&ray)?;
         let si = scene.interaction(&ray, &hit);
         *l += scene.emitted(&si, ray.dir);
-        if scene.has_masks && passes < MAX_MASK_PASSES {
-            let o = opacity(scene, &si);
-            if o < 1.0 && rng.next_f32() >= o {
-                passes += 1;
-                ray = spawn_ray(&si, ray.dir);
-                continue;
-            }
+        if passes_mask(scene, &si, passes, rng) {
+            passes += 1;
+            ray = spawn_ray(&si, ray.dir);
+            continue;
         }
         return Some(si);
     }
