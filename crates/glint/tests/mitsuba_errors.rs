@@ -152,6 +152,41 @@ fn direct_integrator_sample_counts() {
     }
 }
 
+/// Integrators that render what glint's do: `prb` and `prb_basic` read as `path`,
+/// `prbvolpath` as `volpath`, with their parameters; `aov` renders its nested integrator (a
+/// warning says its layers come from `--aov`), and without one it is an error.
+#[test]
+fn integrators_read_as_the_ones_they_render_like() {
+    let dir = scratch("integrator-aliases");
+    use glint::describe::IntegratorDesc;
+    let scene = |integrator: &str| format!("<scene version=\"3.0.0\">\n{SENSOR}\n{integrator}\n</scene>\n");
+    let read = |integrator: &str| {
+        glint::formats::mitsuba::read_str(&scene(integrator), std::path::Path::new("aliases.xml"), &[]).unwrap()
+    };
+    for ty in ["prb", "prb_basic"] {
+        let d = read(&format!(r#"<integrator type="{ty}"><integer name="max_depth" value="3"/></integrator>"#));
+        match d.integrator {
+            IntegratorDesc::Path(p) => assert_eq!(p.max_depth, Some(3), "{ty}"),
+            other => panic!("{ty}: read as {other:?}"),
+        }
+        assert!(d.warnings.is_empty(), "{ty}: {:?}", d.warnings);
+    }
+    let d = read(r#"<integrator type="prbvolpath"><integer name="rr_depth" value="2"/></integrator>"#);
+    assert!(matches!(&d.integrator, IntegratorDesc::Volpath(v) if v.rr_depth == 2), "{:?}", d.integrator);
+
+    let d = read(
+        r#"<integrator type="aov"><string name="aovs" value="dd.y:depth,nn:sh_normal"/>
+    <integrator type="volpath" name="image"><integer name="max_depth" value="7"/></integrator>
+</integrator>"#,
+    );
+    assert!(matches!(&d.integrator, IntegratorDesc::Volpath(v) if v.max_depth == Some(7)), "{:?}", d.integrator);
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+    assert!(d.warnings[0].starts_with("aliases.xml:4:") && d.warnings[0].contains("dd.y:depth"), "{}", d.warnings[0]);
+
+    let e = error_of(&dir, "aov.xml", &scene(r#"<integrator type="aov"/>"#));
+    assert!(e.contains("aov.xml:4:") && e.contains("nested <integrator>"), "{e}");
+}
+
 /// A one-channel `.vol` file of `res` samples per axis (values x fastest).
 fn vol_bytes(res: [i32; 3], channels: i32, values: &[f32]) -> Vec<u8> {
     let mut b = b"VOL\x03".to_vec();

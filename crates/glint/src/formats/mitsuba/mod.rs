@@ -796,8 +796,12 @@ impl<'a> Reader<'a> {
         if ty == "direct" {
             return self.direct_integrator(el, &p);
         }
-        // volpathmis is volpath with spectral MIS, which glint's volpath always uses.
-        if ty == "volpath" || ty == "volpathmis" {
+        if ty == "aov" {
+            return self.aov_integrator(el, &p);
+        }
+        // volpathmis is volpath with spectral MIS, which glint's volpath always uses; Mitsuba's
+        // prbvolpath renders (its primal image) what volpath does, with the same parameters.
+        if ty == "volpath" || ty == "volpathmis" || ty == "prbvolpath" {
             let settings = VolpathSettings {
                 max_depth: depth(&p, -1)?,
                 rr_depth: rr_depth(&p)?,
@@ -806,8 +810,10 @@ impl<'a> Reader<'a> {
             self.warn_unused(&p);
             return Ok(IntegratorDesc::Volpath(settings));
         }
+        // prb and prb_basic (path replay backpropagation, with and without next-event
+        // estimation) render the image path does, with the same parameters.
         let settings = match ty {
-            "path" => PathSettings {
+            "path" | "prb" | "prb_basic" => PathSettings {
                 max_depth: depth(&p, -1)?,
                 rr_depth: rr_depth(&p)?,
                 hide_emitters: p.bool("hide_emitters", false)?,
@@ -824,7 +830,7 @@ impl<'a> Reader<'a> {
                 }
             }
         };
-        if ty == "path" {
+        if matches!(ty, "path" | "prb" | "prb_basic") {
             self.warn_unused(&p);
         }
         Ok(IntegratorDesc::Path(settings))
@@ -832,6 +838,27 @@ impl<'a> Reader<'a> {
 
     /// Mitsuba's `direct`: `shading_samples` (default 1) sets both counts unless
     /// `emitter_samples` or `bsdf_samples` is given (giving both kinds is an error there too).
+    /// Mitsuba's `aov`: the image of its (first) nested integrator. Its layers are not read
+    /// from the file: glint's film keeps the layers `--aov` asks for (a warning says so).
+    fn aov_integrator(&mut self, el: &'a Element, p: &Props<'a>) -> Result<IntegratorDesc, Error> {
+        let mut nested = el.children.iter().filter(|c| c.tag == "integrator");
+        let Some(first) = nested.next() else {
+            return Err(el.err("aov: give the integrator that renders the image as a nested <integrator>"));
+        };
+        if nested.next().is_some() {
+            self.warnings.push(el.err("aov: only the first nested integrator is rendered").to_string());
+        }
+        let layers = p.string("aovs").unwrap_or("");
+        self.warnings.push(
+            el.err(format!(
+                "aov: the layers \"{layers}\" are not written; glint writes the layers --aov asks for \
+                 (albedo, normal, depth, position, ...) beside the image"
+            ))
+            .to_string(),
+        );
+        self.integrator(first)
+    }
+
     fn direct_integrator(&mut self, el: &'a Element, p: &Props<'a>) -> Result<IntegratorDesc, Error> {
         let max = crate::describe::limits::MAX_DIRECT_SAMPLES;
         let count = |name: &str, default: u32| -> Result<u32, Error> {
