@@ -85,9 +85,12 @@ fn brute_force(tris: &[[Vec3; 3]], ray: &Ray) -> Option<f32> {
     best
 }
 
+/// One structure's answer for a ray: the closest hit's distance, and whether it is occluded.
+type Answer = (Option<f32>, bool);
+
 /// Traces `ray` through every structure on every path; checks every reported triangle is
 /// real, and returns the wide trees' closest distances and occlusion answers.
-fn trace_everything(tris: &[[Vec3; 3]], rays: &[Ray]) -> Vec<(Ray, Vec<(Option<f32>, bool)>)> {
+fn trace_everything(tris: &[[Vec3; 3]], rays: &[Ray]) -> Vec<(Ray, Vec<Answer>)> {
     let bounds = tri_bounds(tris);
     let verts = |i: u32| tris[i as usize];
     let mut out = Vec::new();

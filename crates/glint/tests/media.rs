@@ -7,6 +7,7 @@
 //!   are invisible: every pixel is the sky's radiance;
 //! - a scattering medium with RGB extinction renders, channel by channel, what media with
 //!   that channel's extinction in every channel render (the spectral sampling is unbiased).
+//!
 //! Scenes are written in the JSON format, so its media syntax is read on the way.
 
 mod common;
@@ -170,8 +171,8 @@ fn rgb_extinction_is_sampled_without_bias_per_channel() {
     let rgb = render_with(&world, &integrator, 256, 5);
     let k = z_critical(FALSE_ALARM, 3);
     let mut failures = Vec::new();
-    for c in 0..3 {
-        let (grey_world, grey_integrator) = scene(&lit_cloud([sigma[c]; 3]));
+    for (c, &sigma_c) in sigma.iter().enumerate() {
+        let (grey_world, grey_integrator) = scene(&lit_cloud([sigma_c; 3]));
         let grey = render_with(&grey_world, &grey_integrator, 256, 50 + c as u64);
         let (a, b) = (image_estimate(&rgb, c), image_estimate(&grey, c));
         println!("channel {c}: rgb {:.5} ± {:.5}, grey {:.5} ± {:.5}", a.mean, a.se, b.mean, b.se);

@@ -24,8 +24,7 @@ const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="30"/
 
 #[test]
 fn mitsuba_media_attach_to_shapes_by_nesting_and_reference_and_to_the_sensor() {
-    let d = xml(&format!(
-        r#"<medium type="homogeneous" id="fog">
+    let d = xml(r#"<medium type="homogeneous" id="fog">
         <rgb name="sigma_t" value="0.5, 0.25, 0.8"/>
         <float name="scale" value="4"/>
         <rgb name="albedo" value="0.9, 0.8, 0.7"/>
@@ -39,8 +38,7 @@ fn mitsuba_media_attach_to_shapes_by_nesting_and_reference_and_to_the_sensor() {
             <float name="sigma_t" value="10"/>
             <boolean name="sample_emitters" value="false"/>
         </medium>
-    </shape>"#
-    ))
+    </shape>"#)
     .unwrap();
     assert!(matches!(d.integrator, IntegratorDesc::Volpath(ref v) if v.max_depth == Some(9)));
     assert_eq!(d.media.len(), 2);

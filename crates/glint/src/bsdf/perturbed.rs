@@ -90,7 +90,7 @@ impl ShadedBsdf {
             }
             return Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, ..bs });
         }
-        bs.weight = bs.weight * bump_shadowing(f.n, wi);
+        bs.weight *= bump_shadowing(f.n, wi);
         bs.wi = wi;
         Some(bs)
     }

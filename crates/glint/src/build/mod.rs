@@ -30,7 +30,7 @@ use crate::materials::{
 use crate::math::{Aabb, Frame, Mat4, Transform, Vec3};
 use crate::world::World;
 use std::collections::{BTreeSet, HashMap};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Choices that shape the built world but are not part of the scene.
@@ -71,12 +71,12 @@ struct TextureCache {
 }
 
 impl TextureCache {
-    fn bitmap(&mut self, file: &PathBuf, raw: bool, loc: &SourceLoc) -> Result<Arc<Bitmap>, Error> {
-        if let Some(b) = self.bitmaps.get(&(file.clone(), raw)) {
+    fn bitmap(&mut self, file: &Path, raw: bool, loc: &SourceLoc) -> Result<Arc<Bitmap>, Error> {
+        if let Some(b) = self.bitmaps.get(&(file.to_path_buf(), raw)) {
             return Ok(b.clone());
         }
         let bm = Arc::new(Bitmap::load(file, raw).map_err(|e| Error::at(loc, e))?);
-        self.bitmaps.insert((file.clone(), raw), bm.clone());
+        self.bitmaps.insert((file.to_path_buf(), raw), bm.clone());
         Ok(bm)
     }
 

@@ -167,6 +167,8 @@ impl ScalarTexture {
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
+// Kept unboxed: a description is built once and read once; boxes would only change its API.
+#[allow(clippy::large_enum_variant)]
 pub enum MaterialModel {
     Diffuse {
         reflectance: TextureDesc,

@@ -199,7 +199,7 @@ pub fn angle_weighted_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<V
             let b = (p[(k + 2) % 3] - p[k]).normalize();
             let angle = a.dot(b).clamp(-1.0, 1.0).acos();
             if angle.is_finite() {
-                acc[t[k] as usize] = acc[t[k] as usize] + n * angle;
+                acc[t[k] as usize] += n * angle;
             }
         }
     }

@@ -161,6 +161,8 @@ impl MeshEmitter {
 }
 
 #[derive(Clone, Debug)]
+// Unboxed on purpose: lights are read on every light sample, and a box is a pointer chase.
+#[allow(clippy::large_enum_variant)]
 pub enum Light {
     Point {
         position: Vec3,

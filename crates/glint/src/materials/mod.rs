@@ -15,6 +15,8 @@ use crate::bsdf::{Bsdf, Microfacet, PPlasticParams, Phong, PlasticParams};
 use crate::math::Rgb;
 
 #[derive(Clone, Debug)]
+// Unboxed on purpose: materials are read at every hit, and a box is a pointer chase.
+#[allow(clippy::large_enum_variant)]
 pub enum MaterialKind {
     Diffuse {
         reflectance: Texture,

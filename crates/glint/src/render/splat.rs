@@ -103,8 +103,8 @@ impl SplatBuffer {
                     continue;
                 }
                 let s = &mut self.sums[row + (x - self.rect.x0) as usize];
-                for k in 0..3 {
-                    s.sum[k] = s.sum[k].saturating_add(to_fixed(weight * v[k]));
+                for (sum, v) in s.sum.iter_mut().zip(v) {
+                    *sum = sum.saturating_add(to_fixed(weight * v));
                 }
                 s.weight = s.weight.saturating_add(to_fixed(weight));
             }

@@ -179,13 +179,11 @@ fn describe_tree<'a>(
     desc.shapes = r.shapes;
     desc.meshes = r.meshes;
     desc.lights = r.lights;
-    if !desc.media.is_empty() || !r.media.is_empty() {
-        if !matches!(desc.integrator, IntegratorDesc::Volpath(_)) {
-            r.warnings.push(format!(
+    if (!desc.media.is_empty() || !r.media.is_empty()) && !matches!(desc.integrator, IntegratorDesc::Volpath(_)) {
+        r.warnings.push(format!(
                 "{}: the scene has media, which only the volpath integrator renders (they are ignored, as Mitsuba's other integrators ignore them)",
                 path.display()
             ));
-        }
     }
     desc.media = r.media;
     desc.warnings = r.warnings;

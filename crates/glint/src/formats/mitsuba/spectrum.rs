@@ -28,7 +28,7 @@ const CIE_MIN: f64 = 360.0;
 const CIE_MAX: f64 = 830.0;
 const CIE_SAMPLES: usize = 95;
 /// Scales the matching functions so that a unit spectrum has luminance 1.
-const CIE_Y_NORMALIZATION: f64 = 1.0 / 106.7502593994140625;
+const CIE_Y_NORMALIZATION: f64 = 1.0 / 106.750_259_399_414_06;
 /// Scales D65 so that it has luminance 1.
 const CIE_D65_NORMALIZATION: f64 = 1.0 / 98.99741751876255;
 

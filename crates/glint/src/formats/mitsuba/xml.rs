@@ -402,6 +402,60 @@ fn snake_case(s: &str) -> String {
     out
 }
 
+fn upgrade_from_v0(el: &mut Element) {
+    match el.tag.as_str() {
+        "lookAt" => el.tag = "lookat".into(),
+        "srgb" => el.tag = "rgb".into(),
+        _ => {}
+    }
+    for (k, v) in el.attrs.iter_mut() {
+        if k == "name" {
+            *v = match v.as_str() {
+                "toWorld" => "to_world".to_string(),
+                "toUV" => "to_uv".to_string(),
+                other => snake_case(other),
+            };
+        }
+    }
+    for c in el.children.iter_mut() {
+        upgrade_from_v0(c);
+    }
+}
+
+/// Replaces each `$name` by its value, once: the output is not scanned again, so a value
+/// that mentions `$name` (or a default defined as itself) cannot loop.
+fn substitute(el: &mut Element, values: &HashMap<String, String>) -> Result<(), Error> {
+    let loc = el.loc();
+    for (_, v) in el.attrs.iter_mut() {
+        if !v.contains('$') {
+            continue;
+        }
+        let mut out = String::with_capacity(v.len());
+        let mut rest = v.as_str();
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let after = &rest[i + 1..];
+            let len = after.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(after.len());
+            let name = &after[..len];
+            if name.is_empty() {
+                out.push('$');
+            } else {
+                let value = values
+                    .get(name)
+                    .ok_or_else(|| Error::at(&loc, format!("${name} has no <default> and no -D {name}=...")))?;
+                out.push_str(value);
+            }
+            rest = &after[len..];
+        }
+        out.push_str(rest);
+        *v = out;
+    }
+    for c in el.children.iter_mut() {
+        substitute(c, values)?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -547,58 +601,4 @@ mod tests {
         let err = load_tree_str(&text, main, &[], IncludeSource::Memory(&files)).unwrap_err();
         assert!(err.to_string().contains("does not exist"), "{err}");
     }
-}
-
-fn upgrade_from_v0(el: &mut Element) {
-    match el.tag.as_str() {
-        "lookAt" => el.tag = "lookat".into(),
-        "srgb" => el.tag = "rgb".into(),
-        _ => {}
-    }
-    for (k, v) in el.attrs.iter_mut() {
-        if k == "name" {
-            *v = match v.as_str() {
-                "toWorld" => "to_world".to_string(),
-                "toUV" => "to_uv".to_string(),
-                other => snake_case(other),
-            };
-        }
-    }
-    for c in el.children.iter_mut() {
-        upgrade_from_v0(c);
-    }
-}
-
-/// Replaces each `$name` by its value, once: the output is not scanned again, so a value
-/// that mentions `$name` (or a default defined as itself) cannot loop.
-fn substitute(el: &mut Element, values: &HashMap<String, String>) -> Result<(), Error> {
-    let loc = el.loc();
-    for (_, v) in el.attrs.iter_mut() {
-        if !v.contains('$') {
-            continue;
-        }
-        let mut out = String::with_capacity(v.len());
-        let mut rest = v.as_str();
-        while let Some(i) = rest.find('$') {
-            out.push_str(&rest[..i]);
-            let after = &rest[i + 1..];
-            let len = after.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).unwrap_or(after.len());
-            let name = &after[..len];
-            if name.is_empty() {
-                out.push('$');
-            } else {
-                let value = values
-                    .get(name)
-                    .ok_or_else(|| Error::at(&loc, format!("${name} has no <default> and no -D {name}=...")))?;
-                out.push_str(value);
-            }
-            rest = &after[len..];
-        }
-        out.push_str(rest);
-        *v = out;
-    }
-    for c in el.children.iter_mut() {
-        substitute(c, values)?;
-    }
-    Ok(())
 }
