@@ -104,7 +104,8 @@ fn check_batch(mesh: &TriangleMesh, rays: &[Ray]) -> Result<(), TestCaseError> {
         mesh.intersect_batch_with(rays, &mut hits, path);
         // Start from `false` on half the batches, so that a query that left a slot alone
         // cannot pass by the slot's initial value.
-        if rays.len().is_multiple_of(2) {
+        #[allow(clippy::manual_is_multiple_of)] // is_multiple_of needs Rust 1.87
+        if rays.len() % 2 == 0 {
             blocked.fill(false);
         }
         mesh.occluded_batch_with(rays, &mut blocked, path);
