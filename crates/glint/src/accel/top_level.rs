@@ -155,9 +155,9 @@ impl TopLevelBvh {
     /// shortens `ray.t_max` and returns true.
     #[inline]
     pub fn traverse<F: FnMut(u32, &mut Ray) -> bool>(&self, ray: &mut Ray, hit_prim: F) -> bool {
-        // The AVX-512 path keeps the AVX2 kernels here: compiled for AVX-512 (the node test's
-        // mask form, the instances' own code inlined into it) the top level rendered
-        // `scenes/balls-100.json` 4 to 6% slower (BENCHMARKS.md, 2026-12-03).
+        // The AVX-512 path keeps the AVX2 kernels here: with AVX-512's (and the instances'
+        // code inlined into them compiled for AVX-512) `scenes/balls-100.json` rendered 4 to
+        // 6% slower (BENCHMARKS.md, 2026-12-03; the cause was not traced).
         // SAFETY (every arm): each path runs only where the CPU has it.
         match SimdPath::detect() {
             #[cfg(target_arch = "x86_64")]
