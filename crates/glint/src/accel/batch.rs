@@ -17,7 +17,7 @@
 
 use super::simd::Isa;
 use super::wide::{leaf_mask, leaf_range, AnyLeaf, ClosestLeaf, NodeRay, WideBvh, WideNode, EMPTY_CHILD, FAR_SCALE};
-use super::wide::{LEAF_BIT, STACK};
+use super::wide::{push_nearest_last, LEAF_BIT, STACK};
 use crate::math::Ray;
 use std::marker::PhantomData;
 use std::mem::MaybeUninit;
@@ -243,36 +243,17 @@ unsafe fn closest_step<S: Isa, L: ClosestLeaf, const W: usize>(
             }
         }
         if mask != 0 {
-            let first = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            if mask == 0 {
-                walk.cur = node.children[first];
+            if mask & (mask - 1) == 0 {
+                walk.cur = node.children[mask.trailing_zeros() as usize];
                 walk.sp = sp;
                 prefetch_node(nodes, walk.cur);
                 return true;
             }
-            let base = sp;
-            let mut push = |c: u32, d: f32, sp: &mut usize| {
-                let mut j = *sp;
-                // SAFETY: as in `WideBvh::traverse`: entries `base..j` were written, and
-                // `*sp < STACK` because `collapse` checked `depth * (W - 1) + 1 <= STACK`.
-                unsafe {
-                    while j > base && stack.get_unchecked(j - 1).assume_init().1 < d {
-                        *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
-                        j -= 1;
-                    }
-                    stack.get_unchecked_mut(j).write((c, d));
-                }
-                *sp += 1;
-            };
-            push(node.children[first], dist[first], &mut sp);
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                push(node.children[i], dist[i], &mut sp);
-            }
+            // SAFETY: as in `WideBvh::traverse`: `sp + n <= STACK`
+            // because `collapse` checked `depth * (W - 1) + 1 <= STACK`.
+            sp += unsafe { push_nearest_last(&node.children, &dist, mask, stack.as_mut_ptr().add(sp).cast()) };
             sp -= 1;
-            // SAFETY: `push` ran at least twice, so `sp` is below the entries it wrote.
+            // SAFETY: at least two entries were pushed, so `sp` is below them.
             walk.cur = unsafe { stack.get_unchecked(sp).assume_init() }.0;
             walk.sp = sp;
             prefetch_node(nodes, walk.cur);
