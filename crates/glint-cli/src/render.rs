@@ -41,6 +41,7 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let mut session = a.scene.open()?;
     apply_overrides(session.edit(), &a)?;
+    let aovs = session.film_aovs(&aovs);
     let desc = session.description();
     if let Some(c) = &a.crop {
         if c.x1 > desc.film.width || c.y1 > desc.film.height {

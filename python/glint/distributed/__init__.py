@@ -153,7 +153,8 @@ def render(
             recorded = session.load_film(resumes[i])
             out_i = out_i if out_i is not None else (None if recorded is None else os.fspath(recorded))
         if out_i is not None:
-            _check_output(out_i, aovs)
+            # The film's layers: those asked for and those the scene asks for.
+            _check_output(out_i, list(session.aov_channels()))
         ck = checkpoints[i] if checkpoints[i] is not None else resumes[i]
         frames.append(Frame(sc, name, session, _pack.pack(sc), seed, out_i, ck))
     load_seconds = time.perf_counter() - started

@@ -17,10 +17,12 @@ use crate::sampling::{PixelFilter, SamplerKind};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+mod aov;
 mod integrator;
 pub mod limits;
 mod medium;
 mod principled_blend;
+pub use aov::Aov;
 pub use integrator::{DirectSettings, PathSettings, Strategy, WhittedSettings};
 pub use medium::{GridFilter, GridVolumeDesc, GridWrap, MediumDesc, PhaseDesc, VolpathSettings, VolumeDesc};
 pub use principled_blend::{BlendDesc, BlendPartDesc, PrincipledDesc};
@@ -84,6 +86,10 @@ pub struct FilmDesc {
     /// Render only this part of the `width` x `height` image (Mitsuba's crop window).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crop: Option<CropWindow>,
+    /// Layers the scene asks for beside the image (Mitsuba's `aov` integrator); a film gets
+    /// these and those its caller asks for (`Session::new_film`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub aovs: Vec<Aov>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -708,7 +714,14 @@ mod tests {
     fn round_trips_through_json() {
         let mut d = SceneDesc::empty(
             CameraDesc::default(),
-            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None },
+            FilmDesc {
+                width: 4,
+                height: 3,
+                filter: PixelFilter::Box,
+                loc: SourceLoc::default(),
+                crop: None,
+                aovs: Vec::new(),
+            },
         );
         d.shapes.push(ShapeDesc {
             geometry: Geometry::Sphere { center: Vec3::ZERO, radius: 1.0 },
@@ -728,7 +741,14 @@ mod tests {
     fn desc_with_files() -> SceneDesc {
         let mut d = SceneDesc::empty(
             CameraDesc::default(),
-            FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None },
+            FilmDesc {
+                width: 4,
+                height: 3,
+                filter: PixelFilter::Box,
+                loc: SourceLoc::default(),
+                crop: None,
+                aovs: Vec::new(),
+            },
         );
         d.source = Some("scene.xml".into());
         d.includes.push("part.xml".into());

@@ -7,12 +7,12 @@
 use super::json_spans::Spans;
 use crate::bsdf::MicrofacetKind;
 use crate::camera::{CropWindow, FovAxis, Projection};
-use crate::describe::{BlendDesc, BlendPartDesc, PrincipledDesc};
 use crate::describe::{
-    CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
+    Aov, CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
     MaterialModel, MaterialRef, Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc,
     ScalarTexture, SceneDesc, ShapeDesc, ShapeMedia, Strategy, TextureDesc, VolpathSettings, WhittedSettings,
 };
+use crate::describe::{BlendDesc, BlendPartDesc, PrincipledDesc};
 use crate::error::{Error, SourceLoc};
 use crate::lights::LightSelection;
 use crate::materials::conductor_preset;
@@ -98,6 +98,9 @@ struct JsonFilm {
     /// Render only [offset_x, offset_y, width, height] of the image.
     #[serde(default)]
     crop: Option<[u64; 4]>,
+    /// Layers beside the image ("albedo", "depth", ...), as `--aov` names them.
+    #[serde(default)]
+    aovs: Vec<Aov>,
 }
 
 #[derive(Deserialize)]
@@ -814,6 +817,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             let n = |v: u64| v.min(u32::MAX as u64) as u32;
             CropWindow { offset_x: n(x), offset_y: n(y), width: n(w), height: n(h) }
         }),
+        aovs: file.film.aovs.clone(),
     };
     let mut desc = SceneDesc::empty(camera, film);
     desc.source = Some(path.to_path_buf());

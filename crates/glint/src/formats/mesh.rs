@@ -18,7 +18,8 @@ pub fn describe(path: &Path) -> Result<SceneDesc, Error> {
     }
     let camera =
         CameraDesc { to_world: None, fov_degrees: 45.0, fov_axis: FovAxis::Y, loc: loc.clone(), ..Default::default() };
-    let film = FilmDesc { width: 512, height: 512, filter: PixelFilter::Box, loc: loc.clone(), crop: None };
+    let film =
+        FilmDesc { width: 512, height: 512, filter: PixelFilter::Box, loc: loc.clone(), crop: None, aovs: Vec::new() };
     let mut d = SceneDesc::empty(camera, film);
     d.source = Some(path.to_path_buf());
     d.materials.push(MaterialDesc {

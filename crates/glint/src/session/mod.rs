@@ -67,6 +67,8 @@ pub struct FilmOptions {
     pub pass_spp: Option<u32>,
     /// The pixels to render (default: all).
     pub region: Option<Rect>,
+    /// Layers beside the image; the film also keeps those the scene asks for
+    /// ([`Session::film_aovs`]).
     pub aovs: Vec<Aov>,
 }
 
@@ -190,15 +192,30 @@ impl Session {
         }
     }
 
-    /// An empty film for this scene's resolution and samples per pixel.
+    /// An empty film for this scene's resolution and samples per pixel, with the layers
+    /// [`Session::film_aovs`] gives for `opts.aovs`.
     pub fn new_film(&self, opts: &FilmOptions) -> Result<Film, Error> {
         let (w, h) = (self.desc.film.width, self.desc.film.height);
         let region = opts.region.unwrap_or(Rect::full(w, h));
         let pass_spp = opts.pass_spp.unwrap_or(DEFAULT_PASS_SPP);
+        let aovs = self.film_aovs(&opts.aovs);
         // A film the scene's own numbers cannot make (a NaN filter width, say) is the scene's
         // error, reported at its film.
-        Film::with_filter(w, h, region, pass_spp, self.desc.sampler.spp, &opts.aovs, self.desc.film.filter)
+        Film::with_filter(w, h, region, pass_spp, self.desc.sampler.spp, &aovs, self.desc.film.filter)
             .map_err(|e| Error::at(&self.desc.film.loc, e))
+    }
+
+    /// The layers a film of this scene keeps when `requested` are asked for: those, then
+    /// the scene's own (its film's `aovs`) that are not among them. Every front end's film
+    /// (CLI, Python, a render farm's workers) gets the same list, so their films merge.
+    pub fn film_aovs(&self, requested: &[Aov]) -> Vec<Aov> {
+        let mut aovs = requested.to_vec();
+        for a in &self.desc.film.aovs {
+            if !aovs.contains(a) {
+                aovs.push(*a);
+            }
+        }
+        aovs
     }
 
     /// Renders passes into `film` until the requested passes are in, the time is up or

@@ -18,7 +18,7 @@ pub mod xml;
 use super::Define;
 use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
-    CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
+    Aov, CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
     MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
     VolpathSettings,
 };
@@ -82,6 +82,8 @@ struct Reader<'a> {
     /// Media already described, by the element that defines them.
     medium_index: HashMap<*const Element, usize>,
     media: Vec<MediumDesc>,
+    /// Layers an `aov` integrator asks for.
+    aovs: Vec<Aov>,
 }
 
 pub fn read(path: &Path, defines: &[Define]) -> Result<SceneDesc, Error> {
@@ -127,6 +129,7 @@ fn describe_tree<'a>(
         errors: Vec::new(),
         medium_index: HashMap::new(),
         media: Vec::new(),
+        aovs: Vec::new(),
     };
     for c in &root.children {
         if let Some(id) = c.attr("id") {
@@ -174,6 +177,7 @@ fn describe_tree<'a>(
     desc.source = Some(path.to_path_buf());
     desc.includes = tree.included.clone();
     desc.integrator = integrator;
+    desc.film.aovs = std::mem::take(&mut r.aovs);
     desc.sampler = SamplerDesc { kind: SamplerKind::Sobol, spp, seed };
     desc.materials = r.materials;
     desc.shapes = r.shapes;
@@ -705,6 +709,7 @@ impl<'a> Reader<'a> {
             filter: PixelFilter::Gaussian { stddev: 0.5 },
             loc: el.loc(),
             crop: None,
+            aovs: Vec::new(),
         };
         if let Some(f) = film_el {
             if f.attr("type") != Some("hdrfilm") {
@@ -836,8 +841,10 @@ impl<'a> Reader<'a> {
 
     /// Mitsuba's `direct`: `shading_samples` (default 1) sets both counts unless
     /// `emitter_samples` or `bsdf_samples` is given (giving both kinds is an error there too).
-    /// Mitsuba's `aov`: the image of its (first) nested integrator. Its layers are not read
-    /// from the file: glint's film keeps the layers `--aov` asks for (a warning says so).
+    /// Mitsuba's `aov`: the image of its (first) nested integrator, and the layers its
+    /// `aovs` names ("name:type, ..."), those glint's film has: `albedo`, `depth`,
+    /// `position`, and `sh_normal` as `normal`. They keep glint's names (`depth.Z`, ...), not
+    /// the file's; a type glint has no layer for is a warning.
     fn aov_integrator(&mut self, el: &'a Element, p: &Props<'a>) -> Result<IntegratorDesc, Error> {
         let mut nested = el.children.iter().filter(|c| c.tag == "integrator");
         let Some(first) = nested.next() else {
@@ -846,14 +853,34 @@ impl<'a> Reader<'a> {
         if nested.next().is_some() {
             self.warnings.push(el.err("aov: only the first nested integrator is rendered").to_string());
         }
-        let layers = p.string("aovs").unwrap_or("");
-        self.warnings.push(
-            el.err(format!(
-                "aov: the layers \"{layers}\" are not written; glint writes the layers --aov asks for \
-                 (albedo, normal, depth, position, ...) beside the image"
-            ))
-            .to_string(),
-        );
+        let mut missing = Vec::new();
+        for entry in p.string("aovs").unwrap_or("").split(',').map(str::trim).filter(|e| !e.is_empty()) {
+            let Some((_, ty)) = entry.split_once(':') else {
+                return Err(el.err(format!("aov: '{entry}' in aovs is not name:type")));
+            };
+            let aov = match ty.trim() {
+                "albedo" => Aov::Albedo,
+                "depth" => Aov::Depth,
+                "position" => Aov::Position,
+                "sh_normal" => Aov::Normal,
+                _ => {
+                    missing.push(entry);
+                    continue;
+                }
+            };
+            if !self.aovs.contains(&aov) {
+                self.aovs.push(aov);
+            }
+        }
+        if !missing.is_empty() {
+            self.warnings.push(
+                el.err(format!(
+                    "aov: no layer for {} (glint has albedo, depth, position, sh_normal)",
+                    missing.join(", ")
+                ))
+                .to_string(),
+            );
+        }
         self.integrator(first)
     }
 
