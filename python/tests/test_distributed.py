@@ -252,6 +252,18 @@ def test_bad_input_fails_on_the_driver_with_the_cli_message(cli, tmp_path, monke
     assert not (tmp_path / "x.png").exists()
 
 
+def test_layers_the_scene_asks_for_need_an_exr_output(tmp_path, monkeypatch):
+    def no_cluster(*args, **kwargs):
+        raise AssertionError("Ray was reached before the output was checked")
+
+    d = cornell_dict(16)
+    d["film"]["aovs"] = ["depth"]
+    monkeypatch.setattr(ray, "init", no_cluster)
+    with pytest.raises(ValueError, match="exr"):
+        gd.render(glint.load_dict(d, base_dir=SCENES), out=str(tmp_path / "x.png"))
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_command_line_front_end_renders_what_glint_render_does(cli, tmp_path):
     scene = small_scene(tmp_path, size=16)
     subprocess.run([str(cli), "render", str(scene), "-o", str(tmp_path / "cli.pfm"), "--spp", "3", "--quiet"],

@@ -23,6 +23,14 @@ def test_load_dict_matches_file():
     np.testing.assert_array_equal(a, b)
 
 
+def test_layers_the_scene_asks_for_follow_the_requested_ones():
+    d = cornell_dict(16)
+    d["film"]["aovs"] = ["depth", "albedo"]
+    r = glint.render(glint.load_dict(d, base_dir=SCENES), spp=1, aovs=["albedo", "normal"])
+    assert list(r.aovs) == ["albedo", "normal", "depth"]
+    assert r.aovs["depth"].shape == (16, 16, 1)
+
+
 def test_numpy_values_in_dict():
     d = cornell_dict(16)
     d["materials"]["red"]["reflectance"] = np.array([0.63, 0.065, 0.05])
