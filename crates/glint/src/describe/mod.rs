@@ -710,19 +710,13 @@ impl Default for CameraDesc {
 mod tests {
     use super::*;
 
+    fn small_film(aovs: Vec<Aov>) -> FilmDesc {
+        FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None, aovs }
+    }
+
     #[test]
     fn round_trips_through_json() {
-        let mut d = SceneDesc::empty(
-            CameraDesc::default(),
-            FilmDesc {
-                width: 4,
-                height: 3,
-                filter: PixelFilter::Box,
-                loc: SourceLoc::default(),
-                crop: None,
-                aovs: Vec::new(),
-            },
-        );
+        let mut d = SceneDesc::empty(CameraDesc::default(), small_film(vec![Aov::Depth, Aov::Albedo]));
         d.shapes.push(ShapeDesc {
             geometry: Geometry::Sphere { center: Vec3::ZERO, radius: 1.0 },
             to_world: IDENTITY,
@@ -739,17 +733,7 @@ mod tests {
     }
 
     fn desc_with_files() -> SceneDesc {
-        let mut d = SceneDesc::empty(
-            CameraDesc::default(),
-            FilmDesc {
-                width: 4,
-                height: 3,
-                filter: PixelFilter::Box,
-                loc: SourceLoc::default(),
-                crop: None,
-                aovs: Vec::new(),
-            },
-        );
+        let mut d = SceneDesc::empty(CameraDesc::default(), small_film(Vec::new()));
         d.source = Some("scene.xml".into());
         d.includes.push("part.xml".into());
         let bitmap = |f: &str| TextureDesc::Bitmap {
