@@ -839,8 +839,6 @@ impl<'a> Reader<'a> {
         Ok(IntegratorDesc::Path(settings))
     }
 
-    /// Mitsuba's `direct`: `shading_samples` (default 1) sets both counts unless
-    /// `emitter_samples` or `bsdf_samples` is given (giving both kinds is an error there too).
     /// Mitsuba's `aov`: the image of its (first) nested integrator, and the layers its
     /// `aovs` names ("name:type, ..."), those glint's film has: `albedo`, `depth`,
     /// `position`, and `sh_normal` as `normal`. They keep glint's names (`depth.Z`, ...), not
@@ -884,6 +882,8 @@ impl<'a> Reader<'a> {
         self.integrator(first)
     }
 
+    /// Mitsuba's `direct`: `shading_samples` (default 1) sets both counts unless
+    /// `emitter_samples` or `bsdf_samples` is given (giving both kinds is an error there too).
     fn direct_integrator(&mut self, el: &'a Element, p: &Props<'a>) -> Result<IntegratorDesc, Error> {
         let max = crate::describe::limits::MAX_DIRECT_SAMPLES;
         let count = |name: &str, default: u32| -> Result<u32, Error> {
