@@ -190,7 +190,7 @@ def render(
 
     ``spp``: samples per pixel (default: the scene's). ``seed``: the random seed.
     ``time_limit``: seconds after which no pass starts. ``aovs``: extra layers (albedo,
-    normal, depth, position, variance, spp, bvh-cost). ``threads``: worker threads
+    normal, depth, position, variance, spp, bvh-cost); layers the scene asks for follow them. ``threads``: worker threads
     (default: all cores). ``progress(done_spp, total_spp)``: called at most four times a
     second and once at the end. Ctrl-C raises KeyboardInterrupt.
     """

@@ -86,8 +86,9 @@ pub struct FilmDesc {
     /// Render only this part of the `width` x `height` image (Mitsuba's crop window).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crop: Option<CropWindow>,
-    /// Layers the scene asks for beside the image (Mitsuba's `aov` integrator); a film gets
-    /// these and those its caller asks for (`Session::new_film`).
+    /// Layers the scene asks for beside the image (a Mitsuba `aov` integrator's, a JSON
+    /// film's `aovs`); a film keeps those its caller asks for, then these
+    /// (`Session::film_aovs`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub aovs: Vec<Aov>,
 }
