@@ -23,7 +23,7 @@ use std::path::Path;
 fn scene(text: &str) -> (World, Integrator) {
     let desc = json::read(Path::new("media-test.json"), text).unwrap_or_else(|e| panic!("{e}"));
     let world = build(&desc, &BuildOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    (world, Integrator::from(&desc.integrator))
+    (world, desc.integrator.clone())
 }
 
 /// Every channel's whole-image and block means must match `exact[c]` within `k` standard

@@ -177,7 +177,7 @@ impl Session {
 
     /// The integrator the description asks for.
     pub fn integrator(&self) -> Integrator {
-        Integrator::from(&self.desc.integrator)
+        self.desc.integrator.clone()
     }
 
     /// Sampling settings from the description (film filter, sampler, spp, seed).
