@@ -14,7 +14,7 @@ mod common;
 
 use common::scenes::render_with;
 use common::stats::{block_estimates, constant_image_comparisons, image_estimate, z_critical, FALSE_ALARM};
-use glint::build::{build, BuildOptions};
+use glint::assemble::{build, BuildOptions};
 use glint::formats::json;
 use glint::integrators::Integrator;
 use glint::world::World;
@@ -23,7 +23,7 @@ use std::path::Path;
 fn scene(text: &str) -> (World, Integrator) {
     let desc = json::read(Path::new("media-test.json"), text).unwrap_or_else(|e| panic!("{e}"));
     let world = build(&desc, &BuildOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    (world, Integrator::from(&desc.integrator))
+    (world, desc.integrator.clone())
 }
 
 /// Every channel's whole-image and block means must match `exact[c]` within `k` standard

@@ -6,13 +6,8 @@
 //! axis, which the shading frame aligns with the surface's dp/du as Mitsuba does.
 
 use super::{fresnel_dielectric, BsdfSample};
+pub use crate::describe::MicrofacetKind;
 use crate::math::{Rgb, Vec3, PI};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum MicrofacetKind {
-    Ggx,
-    Beckmann,
-}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Microfacet {

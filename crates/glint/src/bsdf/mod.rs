@@ -21,14 +21,13 @@ mod perturbed;
 mod phong;
 mod principled;
 
+pub use crate::describe::principled_eta_of_specular;
 pub use blend::{BlendBsdf, BlendPart};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
 pub use microfacet::{Microfacet, MicrofacetKind};
 pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
 pub use phong::Phong;
-pub use principled::{
-    principled_alphas, principled_eta_of_specular, AnisoGgx, Principled, PrincipledInputs, PrincipledRates,
-};
+pub use principled::{principled_alphas, AnisoGgx, Principled, PrincipledInputs, PrincipledRates};
 
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;

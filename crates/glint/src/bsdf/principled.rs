@@ -229,11 +229,6 @@ pub fn principled_alphas(roughness: f32, anisotropic: f32) -> (f32, f32) {
     ((r2 / aspect).max(0.001), (r2 * aspect).max(0.001))
 }
 
-/// `eta` from Mitsuba's `specular` parameter (normal reflectance 0.08 · specular).
-pub fn principled_eta_of_specular(specular: f32) -> f32 {
-    2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0
-}
-
 /// Whether the configuration of `m` with the two directions is a reflection (or, when
 /// `reflection` is false, a refraction) through that microfacet seen from `wo`'s side.
 fn compatible(m: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, reflection: bool) -> bool {

@@ -85,3 +85,22 @@ impl Default for WhittedSettings {
         WhittedSettings { max_depth: 5, background: [0.0, 0.0, 0.0] }
     }
 }
+
+/// The volumetric path tracer (Mitsuba's `volpath`): the path tracer's depth, roulette and
+/// `hide_emitters`, with media; depth counts scattering events in media and at surfaces
+/// (not passages through `null` boundaries), as Mitsuba counts them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VolpathSettings {
+    /// Longest path in segments; `None` is unbounded.
+    pub max_depth: Option<u32>,
+    /// Depth from which Russian roulette may end paths.
+    pub rr_depth: u32,
+    pub hide_emitters: bool,
+}
+
+impl Default for VolpathSettings {
+    fn default() -> Self {
+        VolpathSettings { max_depth: None, rr_depth: 5, hide_emitters: false }
+    }
+}

@@ -1,5 +1,5 @@
-//! Participating media as a scene describes them, and the settings of the volumetric path
-//! tracer that renders them (the media themselves live in `media`).
+//! Participating media as a scene describes them (the media themselves live in `media`;
+//! the volumetric path tracer's settings are with the other integrators').
 
 use super::Matrix4;
 use crate::error::SourceLoc;
@@ -119,23 +119,4 @@ pub enum PhaseDesc {
     Isotropic,
     /// Henyey-Greenstein with mean cosine `g` in (-1, 1): positive scatters forwards.
     Hg { g: f32 },
-}
-
-/// The volumetric path tracer (Mitsuba's `volpath`): the path tracer's depth, roulette and
-/// `hide_emitters`, with media; depth counts scattering events in media and at surfaces
-/// (not passages through `null` boundaries), as Mitsuba counts them.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct VolpathSettings {
-    /// Longest path in segments; `None` is unbounded.
-    pub max_depth: Option<u32>,
-    /// Depth from which Russian roulette may end paths.
-    pub rr_depth: u32,
-    pub hide_emitters: bool,
-}
-
-impl Default for VolpathSettings {
-    fn default() -> Self {
-        VolpathSettings { max_depth: None, rr_depth: 5, hide_emitters: false }
-    }
 }

@@ -1,6 +1,6 @@
 //! The scene description: what a scene file says, as plain data.
 //!
-//! Readers (`formats`) produce a [`SceneDesc`]; `build` turns it into the render-ready
+//! Readers (`formats`) produce a [`SceneDesc`]; `assemble` turns it into the render-ready
 //! world. Nothing here loads a mesh or an image or builds a BVH: files are named by path,
 //! names are resolved to indices, and every entity carries the [`SourceLoc`] it came from so
 //! that an error found while building still names the file and line. A description is what
@@ -8,24 +8,26 @@
 //! serialises with serde), and overrides (`--width`, `--spp`, a parameter edit) are edits of
 //! it, made before the build.
 
-use crate::bsdf::MicrofacetKind;
-use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::error::SourceLoc;
-use crate::lights::LightSelection;
 use crate::math::{Rgb, Vec3};
-use crate::sampling::{PixelFilter, SamplerKind};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 mod aov;
+mod blend;
+mod camera;
 mod integrator;
 pub mod limits;
 mod medium;
-mod principled_blend;
+mod principled;
+mod sampling;
 pub use aov::Aov;
-pub use integrator::{DirectSettings, PathSettings, Strategy, WhittedSettings};
-pub use medium::{GridFilter, GridVolumeDesc, GridWrap, MediumDesc, PhaseDesc, VolpathSettings, VolumeDesc};
-pub use principled_blend::{BlendDesc, BlendPartDesc, PrincipledDesc};
+pub use blend::{BlendDesc, BlendPartDesc};
+pub use camera::{CropWindow, FovAxis, Projection};
+pub use integrator::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
+pub use medium::{GridFilter, GridVolumeDesc, GridWrap, MediumDesc, PhaseDesc, VolumeDesc};
+pub use principled::{principled_eta_of_specular, PrincipledDesc};
+pub use sampling::{LightSelection, PixelFilter, SamplerKind};
 
 /// A 4x4 row-major object-to-world matrix (column vectors: `p' = M p`).
 pub type Matrix4 = [[f64; 4]; 4];
@@ -122,6 +124,13 @@ pub struct MaterialDesc {
     /// Scatters on both faces (else the back face is black, Mitsuba's default).
     pub two_sided: bool,
     pub loc: SourceLoc,
+}
+
+/// A microfacet distribution of normals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MicrofacetKind {
+    Ggx,
+    Beckmann,
 }
 
 /// A microfacet roughness. `alpha` runs along the surface's dp/du (Mitsuba's `alpha_u`);

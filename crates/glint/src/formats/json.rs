@@ -5,19 +5,16 @@
 //! in the document (`json_spans`), never by searching the text.
 
 use super::json_spans::Spans;
-use crate::bsdf::MicrofacetKind;
-use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
     Aov, CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
     MaterialModel, MaterialRef, Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc,
     ScalarTexture, SceneDesc, ShapeDesc, ShapeMedia, Strategy, TextureDesc, VolpathSettings, WhittedSettings,
 };
 use crate::describe::{BlendDesc, BlendPartDesc, PrincipledDesc};
+use crate::describe::{CropWindow, FovAxis, LightSelection, MicrofacetKind, PixelFilter, Projection, SamplerKind};
 use crate::error::{Error, SourceLoc};
-use crate::lights::LightSelection;
 use crate::materials::conductor_preset;
 use crate::math::{Mat4, Rgb, Transform, Vec3};
-use crate::sampling::{PixelFilter, SamplerKind};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -715,7 +712,7 @@ fn principled_of(ctx: &Ctx, at: &str, p: &JsonPrincipled) -> Result<(MaterialMod
     let eta = match (p.ior, p.specular) {
         (Some(_), Some(_)) => return Err(ctx.err(at, "principled: give either 'ior' or 'specular', not both")),
         (Some(ior), None) => ior,
-        (None, Some(s)) => crate::bsdf::principled_eta_of_specular(s),
+        (None, Some(s)) => crate::describe::principled_eta_of_specular(s),
         (None, None) => d.eta,
     };
     let desc = PrincipledDesc {

@@ -1,14 +1,12 @@
 //! A bare OBJ or PLY file as a scene: the mesh in grey, lit by a grey sky and a sun, seen by
 //! a camera that frames it from the front (for `glint info mesh.obj` and quick previews).
 
-use crate::camera::FovAxis;
 use crate::describe::{
-    CameraDesc, FilmDesc, Geometry, LightDesc, LightKind, MaterialDesc, MaterialModel, MaterialRef, SceneDesc,
-    ShapeDesc, TextureDesc, IDENTITY,
+    CameraDesc, FilmDesc, FovAxis, Geometry, LightDesc, LightKind, MaterialDesc, MaterialModel, MaterialRef,
+    PixelFilter, SceneDesc, ShapeDesc, TextureDesc, IDENTITY,
 };
 use crate::error::{Error, SourceLoc};
 use crate::math::{Rgb, Vec3};
-use crate::sampling::PixelFilter;
 use std::path::Path;
 
 pub fn describe(path: &Path) -> Result<SceneDesc, Error> {

@@ -11,6 +11,9 @@ mod surface;
 mod volpath;
 mod whitted;
 
+/// An integrator is its description: the settings a scene states, with the estimators
+/// implemented here (`li`, `li_batch`).
+pub use crate::describe::IntegratorDesc as Integrator;
 pub use crate::describe::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 pub use path_batch::CameraSample;
@@ -25,25 +28,6 @@ use crate::world::{BatchTraversal, Hit, SurfaceInteraction, World};
 pub struct Counters {
     pub rays: u64,
     pub shadow_rays: u64,
-}
-
-#[derive(Clone, Debug)]
-pub enum Integrator {
-    Whitted(WhittedSettings),
-    Path(PathSettings),
-    Direct(DirectSettings),
-    Volpath(VolpathSettings),
-}
-
-impl From<&crate::describe::IntegratorDesc> for Integrator {
-    fn from(d: &crate::describe::IntegratorDesc) -> Integrator {
-        match d {
-            crate::describe::IntegratorDesc::Whitted(w) => Integrator::Whitted(w.clone()),
-            crate::describe::IntegratorDesc::Path(p) => Integrator::Path(p.clone()),
-            crate::describe::IntegratorDesc::Direct(s) => Integrator::Direct(s.clone()),
-            crate::describe::IntegratorDesc::Volpath(s) => Integrator::Volpath(s.clone()),
-        }
-    }
 }
 
 impl Integrator {

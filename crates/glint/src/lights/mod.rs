@@ -18,12 +18,11 @@
 mod envmap;
 mod projected;
 mod rectangle;
-mod selection;
 mod sphere;
+pub use crate::describe::LightSelection;
 pub use envmap::EnvMap;
 pub use projected::{ProjectedKind, ProjectedLight};
 pub use rectangle::Rectangle;
-pub use selection::LightSelection;
 
 use rectangle::SphericalRectangle;
 

@@ -1,15 +1,17 @@
 //! Materials: what a surface is made of, with textured parameters. `Material::bsdf`
 //! evaluates the textures at a hit point and returns the [`Bsdf`] to scatter with.
 
+mod blend;
 mod conductor_presets;
-mod principled_blend;
+mod principled;
 mod roughness;
 mod surface;
 mod texture;
-pub use principled_blend::{BlendMaterial, BlendMaterialPart, PrincipledMaterial, ScalarTexture};
+pub use blend::{BlendMaterial, BlendMaterialPart};
+pub use principled::PrincipledMaterial;
 pub use roughness::RoughnessMap;
 pub use surface::Perturbation;
-pub use texture::{Bitmap, Texture, TexturePoint};
+pub use texture::{Bitmap, ScalarTexture, Texture, TexturePoint};
 
 use crate::bsdf::{Bsdf, Microfacet, PPlasticParams, Phong, PlasticParams};
 use crate::math::Rgb;

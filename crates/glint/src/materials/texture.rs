@@ -171,3 +171,32 @@ impl From<Rgb> for Texture {
         Texture::Constant(c)
     }
 }
+
+/// A scalar parameter: a constant, or a texture read as its luminance (Mitsuba's `eval_1`).
+#[derive(Clone, Debug)]
+pub enum ScalarTexture {
+    Constant(f32),
+    Texture(Texture),
+}
+
+impl ScalarTexture {
+    pub fn new(t: Texture) -> ScalarTexture {
+        match t {
+            Texture::Constant(c) => ScalarTexture::Constant(c.luminance()),
+            t => ScalarTexture::Texture(t),
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, uv: [f32; 2]) -> f32 {
+        match self {
+            ScalarTexture::Constant(v) => *v,
+            ScalarTexture::Texture(t) => t.eval(uv).luminance(),
+        }
+    }
+
+    /// True when the value is zero everywhere (a constant 0).
+    pub fn is_zero(&self) -> bool {
+        matches!(self, ScalarTexture::Constant(v) if *v == 0.0)
+    }
+}

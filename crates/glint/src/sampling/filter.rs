@@ -3,17 +3,7 @@
 //! (`render::splat`) over every pixel within their radius, weighted as Mitsuba weights them,
 //! each pixel dividing by the weights it received.
 
-#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
-pub enum PixelFilter {
-    /// Uniform over the pixel.
-    #[default]
-    Box,
-    /// Triangle of the given radius (pixels).
-    Tent { radius: f32 },
-    /// Gaussian of the given standard deviation (pixels), windowed at 4 standard deviations
-    /// as Mitsuba does.
-    Gaussian { stddev: f32 },
-}
+use crate::describe::PixelFilter;
 
 impl PixelFilter {
     /// Whether samples are splatted over neighbouring pixels (every filter but the box,

@@ -6,10 +6,11 @@ mod rng;
 mod sampler;
 pub mod warp;
 
+pub use crate::describe::PixelFilter;
+pub use crate::describe::SamplerKind;
 pub use distribution::{DiscreteSample, Distribution1d};
-pub use filter::PixelFilter;
 pub use rng::{mix64, Rng};
-pub use sampler::{Sampler, SamplerKind};
+pub use sampler::Sampler;
 
 /// Power heuristic with beta = 2 (Veach 1997), for multiple importance sampling.
 #[inline]

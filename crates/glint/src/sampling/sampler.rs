@@ -11,27 +11,10 @@
 //!   Estimates stay unbiased (Owen scrambling makes each point uniformly distributed).
 
 use super::{mix64, Rng};
+use crate::describe::SamplerKind;
 
 /// Requests per sample served by Sobol points; deep path vertices use PCG32 numbers.
 const SOBOL_DIMENSIONS: u32 = 64;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-pub enum SamplerKind {
-    Independent,
-    #[default]
-    Sobol,
-}
-
-impl std::str::FromStr for SamplerKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "independent" => Ok(SamplerKind::Independent),
-            "sobol" => Ok(SamplerKind::Sobol),
-            _ => Err(format!("unknown sampler '{s}' (expected sobol or independent)")),
-        }
-    }
-}
 
 pub struct Sampler {
     kind: SamplerKind,

@@ -4,7 +4,7 @@
 //! plugin and parameter by parameter, is listed in docs/mitsuba-support.md; anything else is
 //! an error that names the plugin, the file and the line.
 
-mod bsdfs_extra;
+mod bsdfs;
 mod instances;
 mod media;
 mod polarized;
@@ -16,18 +16,15 @@ mod surface;
 pub mod xml;
 
 use super::Define;
-use crate::camera::{CropWindow, FovAxis, Projection};
 use crate::describe::{
-    Aov, CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialModel,
-    MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
+    Aov, CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialRef,
+    MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
     VolpathSettings,
 };
+use crate::describe::{CropWindow, FovAxis, PixelFilter, Projection, SamplerKind};
 use crate::error::{Error, SourceLoc};
-use crate::materials::conductor_preset;
 use crate::math::{Rgb, Transform, Vec3};
-use crate::sampling::{PixelFilter, SamplerKind};
 use props::{color_of, Props};
-use roughness::RoughnessInput;
 use spectrum::SpectrumUse;
 use std::collections::HashMap;
 use std::path::Path;
@@ -358,102 +355,6 @@ impl<'a> Reader<'a> {
                 Err(e.err(format!("texture plugin '{other}' is not supported (bitmap, checkerboard, mesh_attribute)")))
             }
         }
-    }
-
-    fn ior(&self, p: &Props, name: &str, default: f32) -> Result<f32, Error> {
-        match p.find(name) {
-            None => Ok(default),
-            Some(e) if e.tag == "string" => {
-                let v = e.required("value")?;
-                named_ior(v).ok_or_else(|| e.err(format!("unknown index of refraction '{v}'")))
-            }
-            Some(e) => props::parse_float(e, e.required("value")?),
-        }
-    }
-
-    fn conductor_ior(&self, p: &Props) -> Result<(Rgb, Rgb), Error> {
-        let (eta_el, k_el) = (p.find("eta"), p.find("k"));
-        if eta_el.is_some() || k_el.is_some() {
-            return Ok((
-                p.rgb_as("eta", Rgb::BLACK, SpectrumUse::Unbounded)?,
-                p.rgb_as("k", Rgb::WHITE, SpectrumUse::Unbounded)?,
-            ));
-        }
-        let name = p.string("material").unwrap_or("none");
-        conductor_preset(name)
-            .ok_or_else(|| p.el.err(format!("conductor material '{name}' is not one of Mitsuba's conductor presets (Au, Ag, Cu, Al, Cr, ...: see docs/mitsuba-support.md)")))
-    }
-
-    /// Describes (once) the material of a `<bsdf>` element; its index in the materials.
-    fn material(&mut self, el: &'a Element) -> Result<usize, Error> {
-        let el = self.resolve(el)?;
-        if let Some(&i) = self.material_index.get(&(el as *const Element)) {
-            return Ok(i);
-        }
-        if el.tag != "bsdf" {
-            return Err(el.err(format!("expected a <bsdf>, found <{}>", el.tag)));
-        }
-        let (model, two_sided) = self.material_model(el)?;
-        let name = el.attr("id").map_or_else(|| format!("bsdf@{}:{}", el.file.display(), el.line), str::to_string);
-        let i = self.materials.len();
-        self.materials.push(MaterialDesc { name, model, two_sided, loc: el.loc() });
-        self.material_index.insert(el as *const Element, i);
-        Ok(i)
-    }
-
-    fn material_model(&mut self, el: &'a Element) -> Result<(MaterialModel, bool), Error> {
-        let ty = el.attr("type").unwrap_or("");
-        let p = Props::new(el);
-        let model = match ty {
-            "twosided" => {
-                let inner: Vec<&Element> = el.children.iter().filter(|c| c.tag == "bsdf" || c.tag == "ref").collect();
-                if inner.len() != 1 {
-                    return Err(
-                        el.err("twosided: give exactly one nested <bsdf> (different BSDFs per side are not supported)")
-                    );
-                }
-                let inner = self.resolve(inner[0])?;
-                let (m, _) = self.material_model(inner)?;
-                return Ok((m, true));
-            }
-            "normalmap" | "bumpmap" | "mask" => return self.surface_material(el, ty),
-            "diffuse" => MaterialModel::Diffuse { reflectance: self.texture(&p, "reflectance", Rgb::splat(0.5))? },
-            "conductor" | "roughconductor" => {
-                let roughness =
-                    if ty == "roughconductor" { Some(self.roughness(&p, RoughnessInput::Textured)?) } else { None };
-                let (eta, k) = self.conductor_ior(&p)?;
-                MaterialModel::Conductor { eta, k, specular: p.rgb("specular_reflectance", Rgb::WHITE)?, roughness }
-            }
-            "dielectric" | "roughdielectric" | "thindielectric" => {
-                let eta = self.ior(&p, "int_ior", 1.5046)? / self.ior(&p, "ext_ior", 1.000277)?;
-                let reflect = p.rgb("specular_reflectance", Rgb::WHITE)?;
-                let transmit = p.rgb("specular_transmittance", Rgb::WHITE)?;
-                let roughness =
-                    if ty == "roughdielectric" { Some(self.roughness(&p, RoughnessInput::Textured)?) } else { None };
-                MaterialModel::Dielectric { eta, reflect, transmit, roughness, thin: ty == "thindielectric" }
-            }
-            "plastic" | "roughplastic" => {
-                let eta = self.ior(&p, "int_ior", 1.49)? / self.ior(&p, "ext_ior", 1.000277)?;
-                let diffuse = self.texture(&p, "diffuse_reflectance", Rgb::splat(0.5))?;
-                let specular = p.rgb("specular_reflectance", Rgb::WHITE)?;
-                let nonlinear = p.bool("nonlinear", false)?;
-                let roughness = if ty == "roughplastic" {
-                    Some(self.roughness(&p, RoughnessInput::IsotropicNumber)?)
-                } else {
-                    None
-                };
-                MaterialModel::Plastic { diffuse, specular, eta, roughness, nonlinear }
-            }
-            // Passes light through unchanged: the boundary of a medium (see the volpath integrator).
-            "null" => MaterialModel::Null,
-            "principled" => self.principled(&p)?,
-            "blendbsdf" => self.blend(&p)?,
-            "pplastic" => self.pplastic(&p)?,
-            "polarizer" => self.polarizer(&p)?,
-            other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
-        };
-        self.warn_unused(&p);
-        Ok((model, false))
     }
 
     fn shape(&mut self, el: &'a Element) -> Result<(), Error> {

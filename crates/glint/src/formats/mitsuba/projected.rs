@@ -3,8 +3,7 @@
 use super::props::Props;
 use super::spectrum::SpectrumUse;
 use super::Reader;
-use crate::camera::FovAxis;
-use crate::describe::{LightKind, TextureDesc};
+use crate::describe::{FovAxis, LightKind, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Transform};
 

@@ -4,8 +4,7 @@
 
 use super::props::Props;
 use super::Reader;
-use crate::bsdf::MicrofacetKind;
-use crate::describe::{Roughness, ScalarTexture, TextureDesc};
+use crate::describe::{MicrofacetKind, Roughness, ScalarTexture, TextureDesc};
 use crate::error::Error;
 use crate::math::Rgb;
 

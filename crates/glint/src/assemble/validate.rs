@@ -3,11 +3,11 @@
 //! Each error names the entity's source location and the allowed range.
 
 use crate::describe::{
-    CameraDesc, FilmDesc, Geometry, IntegratorDesc, LightKind, MaterialModel, Matrix4, SceneDesc, TextureDesc,
+    CameraDesc, FilmDesc, Geometry, IntegratorDesc, LightKind, MaterialModel, Matrix4, PixelFilter, SceneDesc,
+    TextureDesc,
 };
 use crate::error::{Error, SourceLoc};
 use crate::math::{Rgb, Vec3};
-use crate::sampling::PixelFilter;
 
 use crate::describe::limits::{check_resolution, MAX_DIRECT_SAMPLES, MAX_SPP, MAX_WHITTED_DEPTH};
 

@@ -1,8 +1,8 @@
-//! Descriptions of the principled BSDF and of blends of two materials (Mitsuba's
-//! `principled` and `blendbsdf`). Scalar parameters that Mitsuba accepts as textures are
-//! [`TextureDesc`]s here, read as the luminance of the colour they give (Mitsuba's `eval_1`).
+//! The description of the principled BSDF (Mitsuba's `principled`). Scalar parameters that
+//! Mitsuba accepts as textures are [`TextureDesc`]s here, read as the luminance of the
+//! colour they give (Mitsuba's `eval_1`).
 
-use super::{MaterialModel, TextureDesc};
+use super::TextureDesc;
 use crate::math::Rgb;
 use serde::{Deserialize, Serialize};
 
@@ -38,7 +38,7 @@ impl Default for PrincipledDesc {
             anisotropic: c(0.0),
             metallic: c(0.0),
             spec_trans: c(0.0),
-            eta: crate::bsdf::principled_eta_of_specular(0.5),
+            eta: principled_eta_of_specular(0.5),
             spec_tint: c(0.0),
             sheen: c(0.0),
             sheen_tint: c(0.0),
@@ -108,17 +108,7 @@ impl PrincipledDesc {
     }
 }
 
-/// One of a blend's two materials, with its own sidedness (a `twosided` inside the blend).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BlendPartDesc {
-    pub model: MaterialModel,
-    pub two_sided: bool,
-}
-
-/// (1 - weight) · first + weight · second; the weight is a grey texture (its luminance).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BlendDesc {
-    pub weight: TextureDesc,
-    pub first: Box<BlendPartDesc>,
-    pub second: Box<BlendPartDesc>,
+/// `eta` from Mitsuba's `specular` parameter (normal reflectance 0.08 · specular).
+pub fn principled_eta_of_specular(specular: f32) -> f32 {
+    2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0
 }
