@@ -32,6 +32,14 @@ impl ProgressBar {
         }
     }
 
+    /// Prints a line on stderr above the bar (or just the line, with no bar).
+    pub fn println(&self, line: &str) {
+        match &self.bar {
+            Some(b) => b.suspend(|| eprintln!("{line}")),
+            None => eprintln!("{line}"),
+        }
+    }
+
     pub fn finish(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();

@@ -182,26 +182,62 @@ fn run(
     session.set_adaptive(adaptive);
     session.set_schedule(job.run.schedule);
     let meta = session.film_meta(&film, Some(&job.output))?;
-    let (mut last_checkpoint, mut last_preview) = (Instant::now(), Instant::now());
+    let mut checkpoints = job.run.checkpoint.as_ref().map(|ck| PeriodicWrite::new(ck, job.run.checkpoint_every));
+    let mut previews = job.run.write_every.map(|every| PeriodicWrite::new(&job.output, every));
     let target = film.spp();
     let report = session.render(&mut film, &control, &mut |film: &Film| {
         bar.set_spp(film_spp(film), target);
-        if let Some(ck) = &job.run.checkpoint {
-            if last_checkpoint.elapsed().as_secs_f64() >= job.run.checkpoint_every {
-                glint::render::write_film(ck, film, &meta)?;
-                last_checkpoint = Instant::now();
-            }
+        if let (Some(ck), Some(w)) = (&job.run.checkpoint, &mut checkpoints) {
+            w.attempt(&bar, job.quiet, || glint::render::write_film(ck, film, &meta));
         }
-        if let Some(every) = job.run.write_every {
-            if last_preview.elapsed().as_secs_f64() >= every {
-                write_film_image(film, &job.output, &[])?;
-                last_preview = Instant::now();
-            }
+        if let Some(w) = &mut previews {
+            w.attempt(&bar, job.quiet, || write_film_image(film, &job.output, &[]));
         }
         Ok(())
     })?;
     bar.finish();
     finish(&film, &meta, &report, load_s, job)
+}
+
+/// A write repeated during the render (a checkpoint, the image so far). One that fails (a
+/// full disk, a folder removed) must not end hours of rendering: it is reported once per
+/// distinct error, the file on disk stays as it was (writes are atomic), the render goes on
+/// and the write is tried again at the next interval.
+struct PeriodicWrite {
+    file: PathBuf,
+    every: f64,
+    last: Instant,
+    failing: Option<String>,
+}
+
+impl PeriodicWrite {
+    fn new(file: &Path, every: f64) -> PeriodicWrite {
+        PeriodicWrite { file: file.to_path_buf(), every, last: Instant::now(), failing: None }
+    }
+
+    fn attempt(&mut self, bar: &ProgressBar, quiet: bool, write: impl FnOnce() -> Result<(), String>) {
+        if self.last.elapsed().as_secs_f64() < self.every {
+            return;
+        }
+        let result = write();
+        self.last = Instant::now();
+        match result {
+            Ok(()) => {
+                if self.failing.take().is_some() && !quiet {
+                    bar.println(&format!("glint: {}: written again", self.file.display()));
+                }
+            }
+            Err(e) => {
+                if self.failing.as_ref() != Some(&e) && !quiet {
+                    bar.println(&format!(
+                        "glint: warning: {e}; rendering goes on (the file keeps its last good state), next try in {} s",
+                        self.every
+                    ));
+                }
+                self.failing = Some(e);
+            }
+        }
+    }
 }
 /// Writes what the render produced and says so; a render stopped by a signal writes the
 /// image so far (and the checkpoint) and exits with 128 + the signal's number.
@@ -213,22 +249,39 @@ fn finish(
     job: &Job,
 ) -> Result<(), CliError> {
     let interrupted = signals::received().filter(|_| report.cancelled);
-    match &job.denoiser {
-        None => write_film_image(film, &job.output, &[])?,
+    let image = match &job.denoiser {
+        None => write_film_image(film, &job.output, &[]),
         Some(oidn) => {
             let noisy = film.image();
             let layer = |aov: Aov| film.aov(aov).map(|l| layer_image(&l)).ok_or("denoise: a guide layer is missing");
             let clean = oidn.denoise(&noisy, &layer(Aov::Albedo)?, &layer(Aov::Normal)?)?;
-            crate::outputs::write_image_and_layers(&clean, film, &job.output, &[("noisy".to_string(), noisy)])?;
+            crate::outputs::write_image_and_layers(&clean, film, &job.output, &[("noisy".to_string(), noisy)])
         }
-    }
-    for f in job.run.checkpoint.iter().chain(&job.run.film_out) {
+    };
+    // The film is written even when the image cannot be (a full disk): it holds the work,
+    // and `glint resume` writes the image from it later.
+    let checkpoint = job.run.checkpoint.as_ref().map(|ck| glint::render::write_film(ck, film, meta));
+    if let Some(f) = &job.run.film_out {
         glint::render::write_film(f, film, meta)?;
+    }
+    let checkpoint_written = matches!(checkpoint, Some(Ok(())));
+    match (image, checkpoint) {
+        (Err(e), Some(Ok(()))) => {
+            let ck = job.run.checkpoint.as_ref().map_or(String::new(), |p| p.display().to_string());
+            return Err(format!("{e} (the film is saved: `glint resume {ck} -o OTHER` writes the image)").into());
+        }
+        (Err(e), _) => return Err(e.into()),
+        // The image is whole; the checkpoint on disk is the last one that could be written.
+        (Ok(()), Some(Err(e))) if !job.quiet => {
+            eprintln!("glint: warning: {e}; the image is written, the checkpoint keeps its last good state")
+        }
+        _ => {}
     }
     let spp = film_spp(film);
     let written = {
         let mut w = vec![job.output.display().to_string()];
-        w.extend(job.run.checkpoint.iter().chain(&job.run.film_out).map(|p| p.display().to_string()));
+        w.extend(job.run.checkpoint.iter().filter(|_| checkpoint_written).map(|p| p.display().to_string()));
+        w.extend(job.run.film_out.iter().map(|p| p.display().to_string()));
         w.join(", ")
     };
     if let Some(sig) = interrupted {

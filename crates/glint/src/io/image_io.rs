@@ -76,15 +76,19 @@ fn write_png(img: &Image, path: &Path) -> Result<(), String> {
     for p in &img.pixels {
         buf.extend_from_slice(&[to_srgb8(p.r), to_srgb8(p.g), to_srgb8(p.b)]);
     }
-    image::save_buffer_with_format(
-        path,
+    // Encoded in memory and written with one checked write: the `image` crate's file writer
+    // drops its buffer unflushed, so a full disk would leave a truncated PNG reported as
+    // written.
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
         &buf,
         img.width as u32,
         img.height as u32,
-        image::ColorType::Rgb8,
-        image::ImageFormat::Png,
+        image::ExtendedColorType::Rgb8,
     )
-    .map_err(|e| e.to_string())
+    .map_err(|e| e.to_string())?;
+    std::fs::write(path, &png).map_err(|e| e.to_string())
 }
 
 fn write_exr(img: &Image, path: &Path) -> Result<(), String> {
