@@ -15,7 +15,7 @@ fuzz_target!(|data: &[u8]| {
     desc.film.width = 4;
     desc.film.height = 4;
     desc.sampler.spp = 1;
-    let Ok(world) = glint::build::build(&desc, &Default::default()) else { return };
+    let Ok(world) = glint::assemble::build(&desc, &Default::default()) else { return };
     let integrator = glint::integrators::Integrator::from(&desc.integrator);
     let settings = glint::render::RenderSettings { spp: 1, ..Default::default() };
     let out = glint::render::render(&world, &integrator, &settings, &glint::render::Silent);

@@ -2,7 +2,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use glint::accel::BvhSplit;
-use glint::build::BuildOptions;
+use glint::assemble::BuildOptions;
 use glint::describe::Strategy;
 use glint::formats::{Define, ReadOptions};
 use glint::lights::LightSelection;

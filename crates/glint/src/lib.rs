@@ -3,7 +3,7 @@
 //! The library is a pipeline whose modules read in order:
 //! - [`formats`] read files (native JSON, Mitsuba XML, bare OBJ/PLY) into a
 //!   [`describe::SceneDesc`], plain data that remembers where each entity came from;
-//! - [`build`] turns a description into the render-ready [`world::World`] (meshes loaded
+//! - [`assemble`] turns a description into the render-ready [`world::World`] (meshes loaded
 //!   once, BVHs built in parallel, area lights made, every default applied);
 //! - [`integrators`] estimate radiance along rays of a world; [`render`] schedules passes of
 //!   samples over tiles and threads into a film;
@@ -15,8 +15,8 @@
 //! and meshes) and [`error`] (one error type with a source location).
 
 pub mod accel;
+pub mod assemble;
 pub mod bsdf;
-pub mod build;
 pub mod camera;
 pub mod describe;
 pub mod error;

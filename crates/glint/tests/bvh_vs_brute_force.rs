@@ -5,7 +5,7 @@
 //! with transformed instances, are checked.
 
 use glint::accel::BvhSplit;
-use glint::build::WorldBuilder;
+use glint::assemble::WorldBuilder;
 use glint::camera::{Camera, FovAxis};
 use glint::geometry::TriangleMesh;
 use glint::lights::LightSelection;

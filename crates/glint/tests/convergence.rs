@@ -16,7 +16,7 @@ mod common;
 use common::scenes::{cornell_box, emission, render_with};
 use common::stats::{z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
-use glint::build::WorldBuilder;
+use glint::assemble::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::LightSelection;

@@ -15,7 +15,7 @@ use common::analytic::{disk_irradiance, polygon_irradiance, sphere_irradiance};
 use common::scenes::{add_quad, add_square, black, camera, diffuse, emission, path, render_with};
 use common::stats::{image_estimate, z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
-use glint::build::WorldBuilder;
+use glint::assemble::WorldBuilder;
 use glint::geometry::disk_mesh;
 use glint::integrators::{DirectSettings, Integrator, Strategy};
 use glint::lights::Light;

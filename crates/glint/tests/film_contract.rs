@@ -8,7 +8,7 @@ mod common;
 use common::scenes::{add_glass_and_metal_balls, add_quad, camera, cornell_box_with, diffuse, path};
 use common::scratch::ScratchDir;
 use glint::accel::BvhSplit;
-use glint::build::WorldBuilder;
+use glint::assemble::WorldBuilder;
 use glint::integrators::{Integrator, Strategy, WhittedSettings};
 use glint::lights::LightSelection;
 use glint::materials::{Material, MaterialKind, Texture};

@@ -11,7 +11,7 @@ mod common;
 use common::scenes::{camera, render_with};
 use common::stats::{check_constant_image, constant_image_comparisons, z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
-use glint::build::WorldBuilder;
+use glint::assemble::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::LightSelection;

@@ -14,7 +14,7 @@ mod common;
 
 use common::scenes::render_with;
 use common::stats::{block_estimates, constant_image_comparisons, image_estimate, z_critical, FALSE_ALARM};
-use glint::build::{build, BuildOptions};
+use glint::assemble::{build, BuildOptions};
 use glint::formats::json;
 use glint::integrators::Integrator;
 use glint::world::World;

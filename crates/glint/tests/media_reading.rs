@@ -148,7 +148,7 @@ fn invalid_media_numbers_are_errors_at_build() {
             if d.warnings.iter().any(|w| w.contains(what)) {
                 return Err(d.warnings.join("\n"));
             }
-            glint::build::build(&d, &Default::default()).map(|_| ()).map_err(|e| e.to_string())
+            glint::assemble::build(&d, &Default::default()).map(|_| ()).map_err(|e| e.to_string())
         });
         let e = result.expect_err(body);
         assert!(e.contains(what) && e.contains("media.xml:"), "{body}: {e}");
@@ -273,7 +273,7 @@ fn bad_albedo_grid_files_are_one_line_errors_at_build() {
         );
         std::fs::write(&scene, &text).unwrap();
         let d = mitsuba::read(&scene, &[]).unwrap();
-        let e = match glint::build::build(&d, &Default::default()) {
+        let e = match glint::assemble::build(&d, &Default::default()) {
             Ok(_) => panic!("{name} built"),
             Err(e) => e.to_string(),
         };
@@ -288,7 +288,7 @@ fn bad_albedo_grid_files_are_one_line_errors_at_build() {
     std::fs::write(dir.join("good.vol"), vol_bytes([2, 1, 1], 3, &[0.1, 0.2, 0.3, 0.4, 0.5, 0.6])).unwrap();
     let scene = dir.join("good.xml");
     std::fs::write(&scene, format!("<scene version=\"3.0.0\"><integrator type=\"volpath\"/>{SENSOR}<shape type=\"sphere\"><bsdf type=\"null\"/><medium type=\"homogeneous\" name=\"interior\"><volume name=\"albedo\" type=\"gridvolume\"><string name=\"filename\" value=\"good.vol\"/></volume></medium></shape></scene>")).unwrap();
-    glint::build::build(&mitsuba::read(&scene, &[]).unwrap(), &Default::default()).unwrap();
+    glint::assemble::build(&mitsuba::read(&scene, &[]).unwrap(), &Default::default()).unwrap();
 }
 
 #[test]
@@ -332,7 +332,7 @@ fn bad_density_grids_are_one_line_errors_at_build() {
             ),
         )
         .unwrap();
-        let e = match glint::build::build(&mitsuba::read(&scene, &[]).unwrap(), &Default::default()) {
+        let e = match glint::assemble::build(&mitsuba::read(&scene, &[]).unwrap(), &Default::default()) {
             Ok(_) => panic!("{name} built"),
             Err(e) => e.to_string(),
         };

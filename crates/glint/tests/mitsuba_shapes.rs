@@ -4,7 +4,7 @@
 mod common;
 
 use common::scratch::ScratchDir;
-use glint::build::{build, BuildOptions};
+use glint::assemble::{build, BuildOptions};
 use glint::camera::{CropWindow, Projection};
 use glint::describe::{Geometry, LightKind, SceneDesc, TextureDesc};
 use glint::formats::mitsuba::read_str;

@@ -11,7 +11,7 @@ mod common;
 use common::scenes::{add_quad, camera, diffuse, render_with};
 use common::stats::{block_estimates, image_estimate, z_critical, Estimate, FALSE_ALARM};
 use glint::accel::BvhSplit;
-use glint::build::WorldBuilder;
+use glint::assemble::WorldBuilder;
 use glint::geometry::{disk_mesh, quad_mesh};
 use glint::integrators::{DirectSettings, Integrator};
 use glint::lights::{AreaEmission, LightSelection};
@@ -269,10 +269,10 @@ fn json_emission_takes_a_texture() {
     assert_eq!(radiance(1), TextureDesc::constant(rgb(1.0, 2.0, 3.0)));
     assert!(matches!(radiance(2), TextureDesc::Bitmap { ref file, .. } if file.ends_with("glow.png")));
     // The bitmap does not exist: building names it, on one line.
-    let err = glint::build::build(&desc, &Default::default()).map(|_| ()).unwrap_err().to_string();
+    let err = glint::assemble::build(&desc, &Default::default()).map(|_| ()).unwrap_err().to_string();
     assert!(err.contains("glow.png") && !err.contains('\n'), "{err}");
     let mut desc = desc;
     desc.shapes.pop();
-    let world = glint::build::build(&desc, &Default::default()).unwrap();
+    let world = glint::assemble::build(&desc, &Default::default()).unwrap();
     assert!(matches!(world.lights()[1], glint::lights::Light::Cylinder { .. }));
 }

@@ -12,7 +12,7 @@ mod common;
 use common::scenes::{add_square, camera, diffuse, emission, render_with};
 use common::stats::{check_constant_image, constant_image_comparisons, z_critical, FALSE_ALARM};
 use glint::accel::BvhSplit;
-use glint::build::WorldBuilder;
+use glint::assemble::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::LightSelection;

@@ -1,6 +1,6 @@
 //! The scene description: what a scene file says, as plain data.
 //!
-//! Readers (`formats`) produce a [`SceneDesc`]; `build` turns it into the render-ready
+//! Readers (`formats`) produce a [`SceneDesc`]; `assemble` turns it into the render-ready
 //! world. Nothing here loads a mesh or an image or builds a BVH: files are named by path,
 //! names are resolved to indices, and every entity carries the [`SourceLoc`] it came from so
 //! that an error found while building still names the file and line. A description is what

@@ -1,5 +1,6 @@
-//! The description of the principled BSDF (Mitsuba's `principled`). Scalar parameters that Mitsuba accepts as textures are
-//! [`TextureDesc`]s here, read as the luminance of the colour they give (Mitsuba's `eval_1`).
+//! The description of the principled BSDF (Mitsuba's `principled`). Scalar parameters that
+//! Mitsuba accepts as textures are [`TextureDesc`]s here, read as the luminance of the
+//! colour they give (Mitsuba's `eval_1`).
 
 use super::TextureDesc;
 use crate::math::Rgb;

@@ -122,7 +122,7 @@ fn mesh_counting(mesh: &crate::geometry::TriangleMesh, ray: &mut Ray, visits: &m
 mod tests {
     use super::*;
     use crate::accel::BvhSplit;
-    use crate::build::WorldBuilder;
+    use crate::assemble::WorldBuilder;
     use crate::camera::{Camera, FovAxis};
     use crate::geometry::quad_mesh;
     use crate::lights::LightSelection;

@@ -199,7 +199,7 @@ fn escaped(s: &WhittedSettings, scene: &World, ray: &Ray, l: Rgb) -> Rgb {
 mod tests {
     use super::*;
     use crate::accel::BvhSplit;
-    use crate::build::WorldBuilder;
+    use crate::assemble::WorldBuilder;
     use crate::camera::{Camera, FovAxis};
     use crate::geometry::quad_mesh;
     use crate::lights::AreaEmission;

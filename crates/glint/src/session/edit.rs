@@ -12,7 +12,7 @@
 //! `shapes.I.to_world`, `camera.fov`, `camera.to_world`.
 
 use super::Session;
-use crate::build::{patch_appearance, BuildCounters};
+use crate::assemble::{patch_appearance, BuildCounters};
 use crate::describe::{
     limits, Emission, LightKind, MaterialModel, Matrix4, Roughness, ScalarTexture, SceneDesc, TextureDesc,
 };
@@ -263,13 +263,13 @@ impl Session {
     /// Brings the built world (if any) up to date with edited parameters.
     fn apply(&mut self, transforms: &[usize]) -> Result<(), Error> {
         if !transforms.is_empty() {
-            crate::build::validate_description(&self.desc)?;
+            crate::assemble::validate_description(&self.desc)?;
             self.instanced.extend(transforms.iter().copied());
             self.world = None;
             return Ok(());
         }
         let (Some(world), Some(layout)) = (&mut self.world, &self.layout) else {
-            return crate::build::validate_description(&self.desc);
+            return crate::assemble::validate_description(&self.desc);
         };
         // The world is shared while a render holds it; it is then built again, from the
         // cached meshes.
@@ -278,7 +278,7 @@ impl Session {
             None => false,
         };
         if !patched {
-            crate::build::validate_description(&self.desc)?;
+            crate::assemble::validate_description(&self.desc)?;
             self.world = None;
         }
         Ok(())

@@ -37,7 +37,7 @@ mod job;
 pub use edit::{Param, ParamValue};
 pub use job::{RenderJob, JOB_VERSION};
 
-use crate::build::{build_cached, BuildOptions, MeshCache, WorldLayout};
+use crate::assemble::{build_cached, BuildOptions, MeshCache, WorldLayout};
 use crate::describe::SceneDesc;
 use crate::error::{Error, SourceLoc};
 use crate::formats::{read, ReadOptions};

@@ -1,5 +1,5 @@
 //! The render-ready world: geometry in a two-level BVH, materials, lights and the camera,
-//! built from a scene description by `build` (the only module that creates one). Its fields
+//! built from a scene description by `assemble` (the only module that creates one). Its fields
 //! are private to the crate: front ends read it through the accessors below.
 //!
 //! Bottom level: one BVH per mesh, in the mesh's own space. Top level: a BVH over

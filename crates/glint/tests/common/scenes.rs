@@ -1,8 +1,8 @@
 //! Small scenes built in code, and the render settings the statistical tests share.
 
 use glint::accel::BvhSplit;
+use glint::assemble::WorldBuilder;
 use glint::bsdf::{Microfacet, MicrofacetKind};
-use glint::build::WorldBuilder;
 use glint::camera::{Camera, FovAxis};
 use glint::geometry::{cube_mesh, quad_mesh};
 use glint::integrators::{Integrator, PathSettings, Strategy};

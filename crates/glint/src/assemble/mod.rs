@@ -5,13 +5,13 @@
 //! source location.
 
 mod builder;
-mod cache;
+mod driver;
 mod media;
 mod validate;
 
 pub use builder::{LoadedGroup, WorldBuilder};
-pub(crate) use cache::patch_appearance;
-pub use cache::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
+pub(crate) use driver::patch_appearance;
+pub use driver::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
 
 use crate::accel::BvhSplit;
 use crate::bsdf::Microfacet;

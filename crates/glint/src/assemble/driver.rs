@@ -1,10 +1,11 @@
-//! Builds that reuse what an earlier build of the same session made. Every mesh BVH (of a
-//! mesh file, an in-description mesh, a primitive, or a copy with its transform baked in)
-//! is kept in a [`MeshCache`], so building the world again after an edit builds only what
-//! the edit changed: nothing geometric after a material, light or camera edit (those are
-//! patched into the built world by [`patch_appearance`]), and only the top-level BVH after
-//! a transform edit (the shape is then traced through its transform instead of being
-//! baked). [`BuildCounters`] count what was built, so tests and users can see it.
+//! The build driver: [`build_cached`] builds a world from a description, reusing what an
+//! earlier build of the same session made. Every mesh BVH (of a mesh file, an
+//! in-description mesh, a primitive, or a copy with its transform baked in) is kept in a
+//! [`MeshCache`], so building the world again after an edit builds only what the edit
+//! changed: nothing geometric after a material, light or camera edit (those are patched into
+//! the built world by [`patch_appearance`]), and only the top-level BVH after a transform
+//! edit (the shape is then traced through its transform instead of being baked).
+//! [`BuildCounters`] count what was built, so tests and users can see it.
 
 use super::builder::{bake, environment_lights, read_mesh_file};
 use super::{add_light, camera, material_id, material_kind, mesh_loc, transform_of, validate, TextureCache};
