@@ -11,6 +11,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import numpy as np
@@ -28,8 +29,9 @@ from glint.distributed import _pack, _plan  # noqa: E402
 
 @pytest.fixture(scope="module")
 def cluster():
-    """A local Ray instance with two CPUs: two worker processes render at once."""
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    """A local Ray instance with two CPUs: two worker processes render at once. Always a new
+    one ("local"): plain ray.init() would join a cluster that `ray start` left running."""
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
     yield
     ray.shutdown()
 
@@ -124,36 +126,59 @@ def test_an_edited_transform_renders_as_locally(cluster):
     same_bits(gd.render(s, spp=2, tile=8).image, glint.render(s, spp=2).image)
 
 
-def busy_workers():
-    """Process ids of Ray worker processes rendering a block now (by their process title)."""
-    found = []
-    for pid in os.listdir("/proc"):
-        try:
-            with open(f"/proc/{pid}/cmdline", "rb") as f:
-                if f.read().startswith(b"ray::render_block"):
-                    found.append(int(pid))
-        except (OSError, ValueError):
-            pass
-    return found
+def stalled_task(flags: pathlib.Path, region, passes):
+    """A stand-in for the worker's task (``_worker.render_block``, which it runs), except
+    that the first attempt of the task (``region``, ``passes``) writes its process id to
+    ``flags/attempt-PID`` and then waits to be killed: a worker is then certainly mid-task
+    when the test kills it. A second attempt (Ray's retry) renders as usual."""
+
+    def task(key, pack_box, spp, seed, aovs, threads, r, p):
+        from glint.distributed import _worker
+
+        if tuple(r) == region and tuple(p) == passes:
+            first = not any(flags.glob("attempt-*"))
+            (flags / f"attempt-{os.getpid()}").touch()
+            deadline = time.monotonic() + 120
+            while first and time.monotonic() < deadline:
+                time.sleep(0.05)
+        return _worker.render_block(key, pack_box, spp, seed, aovs, threads, r, p)
+
+    return task
 
 
-def test_a_worker_killed_mid_render_changes_nothing(cluster):
-    local = glint.render(cornell(64), spp=128, seed=2)
-    killed = []
+def kill_when_started(flags: pathlib.Path, killed: list) -> threading.Thread:
+    """Kills the process whose first attempt of the stalled task announces itself."""
 
-    def kill_one(p):
-        if killed:
-            return
-        assert p.samples_done < p.samples_total  # mid-render
-        deadline = time.monotonic() + 10
-        while not busy_workers() and time.monotonic() < deadline:
+    def run():
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            marks = list(flags.glob("attempt-*"))
+            if marks:
+                pid = int(marks[0].name.split("-")[1])
+                os.kill(pid, signal.SIGKILL)
+                killed.append(pid)
+                return
             time.sleep(0.01)
-        pid = busy_workers()[0]
-        os.kill(pid, signal.SIGKILL)
-        killed.append(pid)
 
-    r = gd.render(cornell(64), spp=128, seed=2, tile=32, passes_per_task=16, report=kill_one)
-    assert killed and killed[0] not in busy_workers()
+    t = threading.Thread(target=run, daemon=True)
+    t.start()
+    return t
+
+
+def test_a_worker_killed_mid_render_changes_nothing(cluster, tmp_path, monkeypatch):
+    # Deterministic: the worker killed is one that is running a task of this render (not
+    # found by process title, which matched any Ray cluster's workers on the machine and
+    # raced with the task's end), and Ray's retry of that task is seen to run.
+    from glint.distributed import _worker
+
+    local = glint.render(cornell(64), spp=128, seed=2)
+    monkeypatch.setattr(_worker, "render_block", stalled_task(tmp_path, (0, 0, 32, 32), (0, 16)))
+    killed: list = []
+    killer = kill_when_started(tmp_path, killed)
+    r = gd.render(cornell(64), spp=128, seed=2, tile=32, passes_per_task=16)
+    killer.join()
+    attempts = sorted(int(m.name.split("-")[1]) for m in tmp_path.glob("attempt-*"))
+    assert len(killed) == 1 and killed[0] in attempts and len(attempts) == 2  # killed, then retried
     same_bits(r.image, local.image)
     assert r.stats["tasks"] == 4 * 8
 
@@ -274,3 +299,29 @@ def test_command_line_front_end_renders_what_glint_render_does(cli, tmp_path):
     assert (tmp_path / "dist.pfm").read_bytes() == (tmp_path / "cli.pfm").read_bytes()
     summary = [line for line in p.stderr.splitlines() if line.startswith("glint: ")]
     assert len(summary) == 1 and " 16x16 @ 3 spp in " in summary[0] and summary[0].endswith("dist.pfm")
+
+
+def test_a_checkpoint_that_cannot_be_written_warns_and_the_render_goes_on(cluster, tmp_path):
+    # The checkpoint's folder vanishes mid-render (as on a full disk, the write fails): one
+    # warning, the render goes on to the same bits, and its image is written.
+    scene = small_scene(tmp_path, size=16)
+    folder = tmp_path / "checkpoints"
+    folder.mkdir()
+    ck, out = folder / "render.film", tmp_path / "dist.pfm"
+    blocks = []
+
+    def remove_after_two(p):
+        blocks.append(p)
+        if len(blocks) == 2:
+            assert ck.exists()  # written after the first block
+            shutil.rmtree(folder)
+
+    with pytest.warns(RuntimeWarning) as caught:
+        r = gd.render(scene, spp=4, seed=1, out=out, tile=8, passes_per_task=1, checkpoint=ck,
+                      checkpoint_every=1e-6, report=remove_after_two)
+    messages = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+    assert len([m for m in messages if "next try in" in m]) == 1, messages  # once, not per block
+    assert any("the image is written" in m for m in messages), messages
+    assert all(str(ck) in m and "No such file or directory" in m for m in messages), messages
+    same_bits(r.image, glint.render(glint.load_file(scene), spp=4, seed=1).image)
+    assert out.exists() and not folder.exists()

@@ -43,6 +43,35 @@ def _ray() -> Any:
     return ray
 
 
+def _address(address: Optional[str]) -> str:
+    """What ``ray.init`` is given. No address: ``RAY_ADDRESS`` if set, else a new local
+    instance ("local"; plain ``ray.init()`` would join whatever cluster ``ray start`` last
+    started on this machine). Given an address, Ray's token authentication is turned on if
+    a token is at hand (``RAY_AUTH_TOKEN``, ``RAY_AUTH_TOKEN_PATH`` or ``~/.ray/auth_token``)
+    and ``RAY_AUTH_MODE`` is unset, as Ray does for a cluster it finds itself: ``ray start
+    --head`` turns authentication on when the token file exists, but Ray leaves it off for a
+    driver given an explicit address, which the cluster then refuses. A cluster without
+    authentication accepts a driver that sends a token."""
+    if address is None:
+        address = os.environ.get("RAY_ADDRESS") or "local"
+    if address != "local" and "RAY_AUTH_MODE" not in os.environ:
+        import logging
+
+        try:
+            # What Ray does itself for a cluster it finds on its own (Ray 2.5x and later).
+            from ray._private.authentication import authentication_token_setup as auth
+        except ImportError:
+            return address
+        quiet = logging.getLogger(auth.__name__)
+        level = quiet.level
+        quiet.setLevel(logging.ERROR)  # not "token authentication is enabled" on every call
+        try:
+            auth.maybe_enable_token_auth_if_token_available(warn_if_disabled=False)
+        finally:
+            quiet.setLevel(level)
+    return address
+
+
 def _per_frame(value: Any, n: int, arg: str) -> List[Optional[str]]:
     """One path per frame: None, a list of n, or (for several frames) a pattern with
     ``{frame}`` (``"frame-{frame:03d}.exr"``)."""
@@ -164,7 +193,7 @@ def render(
     if own_ray:
         import logging
 
-        ray.init(address=address, include_dashboard=False, logging_level=logging.WARNING)
+        ray.init(address=_address(address), include_dashboard=False, logging_level=logging.WARNING)
     try:
         options = _Options(tile, passes_per_task, cpus_per_task, max_retries, aovs, checkpoint_every)
         # Time to load and build the scene on the driver, and to start or reach Ray.

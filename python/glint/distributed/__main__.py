@@ -7,6 +7,7 @@ import math
 import signal
 import sys
 import time
+import warnings
 from typing import List, Optional
 
 from .._errors import SceneError
@@ -99,6 +100,10 @@ def main(argv: Optional[List[str]] = None) -> int:
         raise KeyboardInterrupt
 
     signal.signal(signal.SIGTERM, on_term)
+    # A checkpoint that cannot be written warns (RuntimeWarning): one line, as glint render.
+    warnings.showwarning = lambda message, *_args, **_kw: None if a.quiet else print(
+        f"glint: warning: {message}", file=sys.stderr
+    )
     bar = Bar(not a.quiet and sys.stderr.isatty())
     target = [0, 0]
 

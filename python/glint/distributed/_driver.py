@@ -7,6 +7,7 @@ so the order of addition changes no bit: the image equals a local render's whate
 arrival order, retries included."""
 
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional
 
@@ -39,6 +40,7 @@ class Frame:
     pack_ref: Any = None
     tasks_left: int = 0
     dirty: bool = False
+    checkpoint_error: Optional[str] = None
     rays: Dict[str, int] = field(default_factory=lambda: dict(RAY_COUNTS))
 
 
@@ -175,9 +177,24 @@ class Driver:
         return Progress(self.samples_done, self.samples_total, spp_done, spp_total, rays, elapsed)
 
     def write_checkpoints(self) -> None:
+        """A checkpoint that cannot be written (a full disk, a folder removed) does not end
+        the render: it warns once per distinct error (``RuntimeWarning``), the file keeps
+        its last good state (writes are atomic), and it is tried again next time."""
         for f in self.frames:
             if f.checkpoint and f.dirty:
-                f.session.save_film(f.checkpoint, f.out)
+                try:
+                    f.session.save_film(f.checkpoint, f.out)
+                except OSError as e:
+                    if str(e) != f.checkpoint_error:
+                        warnings.warn(
+                            f"{e}; rendering goes on (the file keeps its last good state), "
+                            f"next try in {self.checkpoint_every:g} s",
+                            RuntimeWarning,
+                            stacklevel=2,
+                        )
+                    f.checkpoint_error = str(e)
+                    continue
+                f.checkpoint_error = None
                 f.dirty = False
 
 
@@ -189,9 +206,26 @@ def write_frame(f: Frame) -> None:
     """Writes the frame's image (its AOV layers beside it in an EXR file) and checkpoint."""
     from .. import write_image
 
+    image_error = None
     if f.out:
         aovs = f.session.aovs()
-        write_image(f.out, f.session.image(), aovs or None)
+        try:
+            write_image(f.out, f.session.image(), aovs or None)
+        except OSError as e:
+            image_error = e
+    # The film is written even when the image cannot be (a full disk): it holds the work.
     if f.checkpoint:
-        f.session.save_film(f.checkpoint, f.out)
-        f.dirty = False
+        try:
+            f.session.save_film(f.checkpoint, f.out)
+        except OSError as e:
+            if image_error is not None:
+                raise image_error from None
+            warnings.warn(f"{e}; the image is written, the checkpoint keeps its last good state", RuntimeWarning)
+        else:
+            f.dirty = False
+            if image_error is not None:
+                raise OSError(
+                    f"{image_error} (the film is saved: `glint resume {f.checkpoint} -o OTHER` writes the image)"
+                ) from None
+    if image_error is not None:
+        raise image_error
