@@ -26,11 +26,12 @@ import numpy as np
 
 from . import _glint
 from ._errors import SceneError
-from ._glint import DEFAULT_PASS_SPP, Scene, Session
+from ._glint import DEFAULT_PASS_SPP, Preview, Scene, Session
 from ._denoise import denoise
 
 __all__ = [
     "DEFAULT_PASS_SPP",
+    "Preview",
     "RenderResult",
     "Scene",
     "SceneError",
@@ -185,6 +186,7 @@ def render(
     aovs: Sequence[str] = (),
     threads: Optional[int] = None,
     progress: Optional[Callable[[int, int], Any]] = None,
+    preview: Union[bool, str] = False,
 ) -> RenderResult:
     """Renders the scene and returns a RenderResult.
 
@@ -192,15 +194,36 @@ def render(
     ``time_limit``: seconds after which no pass starts. ``aovs``: extra layers (albedo,
     normal, depth, position, variance, spp, bvh-cost); layers the scene asks for follow them. ``threads``: worker threads
     (default: all cores). ``progress(done_spp, total_spp)``: called at most four times a
-    second and once at the end. Ctrl-C raises KeyboardInterrupt.
+    second and once at the end. Ctrl-C raises KeyboardInterrupt. ``preview``: True (or an
+    address, "HOST:PORT") serves a live view of the render in the browser, shown inline in
+    Jupyter and its address printed elsewhere (``Session.preview``); its Stop button ends
+    the render after the current pass, and the result holds the passes done.
     """
     s = make_session(scene, spp=spp, seed=seed, aovs=aovs, threads=threads)
+    if preview is not False and preview is not None:
+        if not isinstance(preview, (bool, str)):
+            raise TypeError(f"preview must be True or an address, not {type(preview).__name__}")
+        show_preview(s.preview(None if preview is True else preview))
     if time_limit is not None and not isinstance(time_limit, (int, float)):
         raise TypeError(f"time_limit must be a number of seconds, not {type(time_limit).__name__}")
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable")
     s.render_passes(None, time_limit, progress)
     return RenderResult(image=s.image(), aovs=dict(s.aovs()), spp=s.spp, stats=dict(s.stats))
+
+
+def show_preview(p: Preview) -> None:
+    """Shows a preview inline in Jupyter (IPython), or prints its address on stderr."""
+    import sys
+
+    ipython = sys.modules.get("IPython")
+    shell = ipython.get_ipython() if ipython is not None else None
+    if shell is not None and getattr(shell, "kernel", None) is not None:
+        from IPython.display import display
+
+        display(p)
+    else:
+        print(f"glint: preview at {p.url}", file=sys.stderr, flush=True)
 
 
 def make_session(

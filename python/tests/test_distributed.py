@@ -325,3 +325,32 @@ def test_a_checkpoint_that_cannot_be_written_warns_and_the_render_goes_on(cluste
     assert all(str(ck) in m and "No such file or directory" in m for m in messages), messages
     same_bits(r.image, glint.render(glint.load_file(scene), spp=4, seed=1).image)
     assert out.exists() and not folder.exists()
+
+
+def test_the_preview_shows_the_merged_film_and_the_workers_and_its_stop_acts_as_ctrl_c(cluster, tmp_path):
+    import re
+    import socket
+    import urllib.request
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    url = f"http://127.0.0.1:{port}/"
+    seen = []
+
+    def report(_progress):
+        seen.append(json.loads(urllib.request.urlopen(url + "state", timeout=30).read()))
+        if len(seen) == 4:
+            page = urllib.request.urlopen(url, timeout=30).read().decode()
+            token = re.search(r'const TOKEN = "([0-9a-f]+)"', page).group(1)
+            urllib.request.urlopen(url + f"stop?token={token}", timeout=30).read()
+
+    out = tmp_path / "stopped.pfm"
+    with pytest.raises(KeyboardInterrupt):
+        gd.render(cornell(32), spp=40, out=out, tile=16, passes_per_task=2, report=report,
+                  preview=f"127.0.0.1:{port}")
+    assert out.exists(), "the image so far is written, as after Ctrl-C"
+    shown = [s for s in seen if s["frame"] > 0]
+    assert shown and shown[-1]["width"] == 32 and shown[-1]["progress"]["spp"] < 40
+    workers = shown[-1]["workers"]
+    assert 1 <= len(workers) <= 2 and all(w["name"].startswith("pid ") and w["total"] == 80 for w in workers)

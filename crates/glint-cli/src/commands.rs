@@ -20,7 +20,8 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene (.json, or Mitsuba 3 .xml) to an image (.png, .exr or .pfm).
+    /// Render a scene to an image (.png, .exr or .pfm). Scenes: glint's JSON (.json),
+    /// Mitsuba 3 XML (.xml), or a bare mesh (.obj, .ply) in a preview setting.
     Render(RenderArgs),
     /// Continue a checkpointed render (bit-identical to an uninterrupted one).
     Resume(ResumeArgs),
@@ -36,7 +37,7 @@ enum Command {
 
 #[derive(Args)]
 pub struct SceneArgs {
-    /// Scene file.
+    /// Scene file: glint JSON (.json), Mitsuba 3 XML (.xml), or a bare OBJ or PLY mesh.
     pub scene: PathBuf,
     /// BVH split strategy: sah (binned surface area heuristic) or median (the paper's).
     #[arg(long, default_value = "sah", value_parser = parse_split)]
@@ -50,9 +51,10 @@ pub struct SceneArgs {
 pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Output image; the extension chooses the format.
-    #[arg(short, long, default_value = "out.png")]
-    pub output: PathBuf,
+    /// Output image; the extension chooses the format (default: the scene's name with .png,
+    /// next to the scene).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
     /// Samples per pixel (default: the scene's).
     #[arg(long)]
     pub spp: Option<u32>,
@@ -138,6 +140,15 @@ pub struct RunArgs {
     /// rays in flight) or one-path (each path to its end). Same image under each.
     #[arg(long, default_value = "wavefront")]
     pub schedule: Schedule,
+    /// Serve a live view of the render in the browser at ADDR (HOST:PORT or PORT; default
+    /// 127.0.0.1 at a free port, printed on start): the image as passes land, its layers, a
+    /// pixel inspector and a Stop button that ends the render as Ctrl-C does.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "")]
+    pub preview: Option<String>,
+    /// Send the image and its layers to tev (the image viewer) at HOST:PORT as passes land
+    /// (tev listens on 127.0.0.1:14158 by default).
+    #[arg(long, value_name = "HOST:PORT")]
+    pub tev: Option<String>,
 }
 
 #[derive(Args)]

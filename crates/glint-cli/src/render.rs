@@ -8,6 +8,7 @@ use crate::outputs::{output_files, temp_files, write_film_image};
 use crate::progress::ProgressBar;
 use crate::signals;
 use glint::describe::{DirectSettings, IntegratorDesc, PathSettings, SceneDesc, WhittedSettings};
+use glint::preview::{film_spp, FilmSink, PreviewServer, TevSink};
 use glint::render::{Adaptive, Aov, Film};
 use glint::session::{FilmOptions, RenderControl, RenderReport, Session};
 use std::io::IsTerminal;
@@ -16,7 +17,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
-    glint::io::image_io::ImageFormat::from_path(&a.output)?;
+    // Without -o the image goes next to the scene, named after it (the summary says where).
+    let output = a.output.clone().unwrap_or_else(|| a.scene.scene.with_extension("png"));
+    glint::io::image_io::ImageFormat::from_path(&output)?;
     if a.adaptive && a.passes.is_some() {
         return Err("--adaptive cannot be combined with --passes (its decisions need every earlier pass)".into());
     }
@@ -48,7 +51,7 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
             return Err(format!("--crop {c} is outside the {}x{} image", desc.film.width, desc.film.height).into());
         }
     }
-    for out in output_files(&a.output, &aovs) {
+    for out in output_files(&output, &aovs) {
         check_output(&out, desc)?;
     }
     for f in a.run.checkpoint.iter().chain(&a.run.film_out) {
@@ -67,13 +70,8 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
     }
     let adaptive =
         a.adaptive.then_some(Adaptive { threshold: a.adaptive_threshold, min_passes: a.adaptive_min_passes });
-    let job = Job {
-        scene_name: a.scene.scene.display().to_string(),
-        output: a.output.clone(),
-        run: a.run.clone(),
-        quiet: a.quiet,
-        denoiser,
-    };
+    let job =
+        Job { scene_name: a.scene.scene.display().to_string(), output, run: a.run.clone(), quiet: a.quiet, denoiser };
     run(session, film, a.passes.clone(), adaptive, start, &job)
 }
 
@@ -139,14 +137,6 @@ fn check_run_args(r: &RunArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The samples per pixel the film holds (over its region, for the passes it has).
-fn film_spp(film: &Film) -> u32 {
-    let mut passes: Vec<u32> = film.blocks().iter().flat_map(|b| b.passes.clone()).collect();
-    passes.sort_unstable();
-    passes.dedup();
-    passes.iter().map(|&p| film.pass_samples(p).len() as u32).sum()
-}
-
 fn run(
     mut session: Session,
     mut film: Film,
@@ -167,6 +157,19 @@ fn run(
         signals::register_temp(&glint::io::layers::temp_path(f));
     }
     signals::install();
+    // The page's title and tev's image name: the scene file's name.
+    let title = Path::new(&job.scene_name).file_name().map_or(job.scene_name.clone(), |n| n.to_string_lossy().into());
+    let preview = match &job.run.preview {
+        Some(addr) => Some(PreviewServer::start((!addr.is_empty()).then_some(addr.as_str()), &title)?),
+        None => None,
+    };
+    if let Some(p) = &preview {
+        eprintln!("glint: preview at {}", p.url());
+    }
+    let tev = job.run.tev.as_deref().map(|addr| TevSink::connect(addr, &title)).transpose()?;
+    let mut sinks: Vec<&dyn FilmSink> = Vec::new();
+    sinks.extend(preview.as_ref().map(|p| p as &dyn FilmSink));
+    sinks.extend(tev.as_ref().map(|t| t as &dyn FilmSink));
 
     let requested = passes.clone().unwrap_or(film.passes_done()..film.pass_count());
     let show_bar = !job.quiet && std::io::stderr().is_terminal();
@@ -177,6 +180,7 @@ fn run(
         cancel: &signals::CANCEL,
         time_limit: job.run.time_limit.map(Duration::from_secs_f64),
         progress: &bar,
+        sinks: &sinks,
     };
     // What a checkpoint records is fixed for the whole render: work it out once.
     session.set_adaptive(adaptive);
@@ -196,6 +200,9 @@ fn run(
         Ok(())
     })?;
     bar.finish();
+    if let Some(e) = tev.as_ref().and_then(|t| t.error()) {
+        eprintln!("glint: warning: {e}");
+    }
     finish(&film, &meta, &report, load_s, job)
 }
 
@@ -248,7 +255,9 @@ fn finish(
     load_s: f64,
     job: &Job,
 ) -> Result<(), CliError> {
-    let interrupted = signals::received().filter(|_| report.cancelled);
+    // The preview's Stop button ends the render as Ctrl-C does.
+    let interrupted =
+        signals::received().filter(|_| report.cancelled).or(report.stopped_by_viewer.then_some(signals::SIGINT));
     let image = match &job.denoiser {
         None => write_film_image(film, &job.output, &[]),
         Some(oidn) => {
@@ -286,7 +295,8 @@ fn finish(
     };
     if let Some(sig) = interrupted {
         if !job.quiet {
-            eprintln!("glint: interrupted at {spp} of {} spp: wrote {written}", film.spp());
+            let how = if report.stopped_by_viewer { "stopped from the preview" } else { "interrupted" };
+            eprintln!("glint: {how} at {spp} of {} spp: wrote {written}", film.spp());
         }
         return Err(CliError { message: String::new(), code: signals::exit_code(sig) });
     }

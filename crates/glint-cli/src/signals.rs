@@ -15,6 +15,9 @@ static COUNT: AtomicU32 = AtomicU32::new(0);
 const MAX_TEMPS: usize = 64;
 static TEMPS: [AtomicPtr<std::ffi::c_char>; MAX_TEMPS] = [const { AtomicPtr::new(std::ptr::null_mut()) }; MAX_TEMPS];
 
+/// SIGINT's number (Ctrl-C), whose exit code a render stopped from its preview gives too.
+pub const SIGINT: i32 = 2;
+
 /// The signal that stopped the render, if one did.
 pub fn received() -> Option<i32> {
     match SIGNAL.load(Ordering::SeqCst) {

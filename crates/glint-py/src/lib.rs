@@ -4,6 +4,7 @@
 
 mod convert;
 mod images;
+mod preview;
 mod render;
 mod scene;
 
@@ -13,6 +14,7 @@ use pyo3::prelude::*;
 fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_class::<render::Session>()?;
+    m.add_class::<preview::Preview>()?;
     m.add_function(wrap_pyfunction!(scene::load_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_json, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_description, m)?)?;

@@ -3,8 +3,10 @@
 
 use crate::convert::{guard, panic_message, scene_error};
 use crate::images::image_array;
+use crate::preview::Preview;
 use crate::scene::Scene;
 use glint::error::SourceLoc;
+use glint::preview::{FilmSink, PreviewServer, RenderProgress};
 use glint::render::checkpoint::{decode_film, encode_film};
 use glint::render::{write_film, Aov, Film, FilmMeta, Rect, RenderStats, Silent};
 use glint::session::{read_film_and_job, FilmOptions, RenderControl, RenderJob, RenderReport};
@@ -15,6 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::Arc;
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
@@ -35,6 +38,14 @@ pub struct Session {
     /// What checkpoints record beside the sums, for the output named: worked out once, as
     /// it hashes every file of the scene.
     meta: Option<(Option<PathBuf>, FilmMeta)>,
+    /// The live preview its renders feed, once asked for.
+    preview: Option<Arc<PreviewServer>>,
+}
+
+impl Session {
+    pub fn film(&self) -> &Film {
+        &self.film
+    }
 }
 
 /// A film's blocks as ((x0, y0, x1, y1), (first pass, end pass)).
@@ -114,7 +125,7 @@ impl Session {
                 .new_film(&FilmOptions { pass_spp: None, region, aovs })
                 .map_err(|e| PyValueError::new_err(e.message))?;
             drop(s);
-            Ok(Session { scene, film, seed, threads, stats: RenderStats::default(), meta: None })
+            Ok(Session { scene, film, seed, threads, stats: RenderStats::default(), meta: None, preview: None })
         })
     }
 
@@ -133,6 +144,30 @@ impl Session {
         first: Option<u32>,
     ) -> PyResult<u32> {
         guard(|| self.render_inner(py, passes, time_limit, progress, first))
+    }
+
+    /// Serves a live preview of this session's renders (the page `glint render --preview`
+    /// serves) at `address` ("HOST:PORT" or a port; default 127.0.0.1 at a free port) and
+    /// returns it (its `url`; shown inline in Jupyter). Its Stop button ends a render after
+    /// the current pass, keeping the passes done. Called again, returns the same preview.
+    #[pyo3(signature = (address=None))]
+    fn preview(&mut self, py: Python<'_>, address: Option<String>) -> PyResult<Preview> {
+        if let Some(server) = &self.preview {
+            return Ok(Preview { server: server.clone() });
+        }
+        let title = self.scene.borrow(py).title();
+        let p = Preview::start(address.as_deref(), &title)?;
+        let progress = RenderProgress {
+            spp: glint::preview::film_spp(&self.film),
+            target_spp: self.film.spp(),
+            passes_done: self.film.passes_done(),
+            pass_count: self.film.pass_count(),
+            state: if self.film.passes_done() == self.film.pass_count() { "done" } else { "rendering" },
+            ..Default::default()
+        };
+        p.server.publish(&self.film, &progress);
+        self.preview = Some(p.server.clone());
+        Ok(p)
     }
 
     /// The film as bytes in the checkpoint format (GLINTFLM), with no scene hash or
@@ -317,6 +352,10 @@ impl Session {
         scene.session.set_sampling(Some(self.film.spp()), Some(self.seed)).map_err(|e| scene_error(py, e))?;
         let session = &mut scene.session;
         let film = &mut self.film;
+        if let Some(p) = &self.preview {
+            p.clear_stop();
+        }
+        let sinks: Vec<&dyn FilmSink> = self.preview.iter().map(|p| p.as_ref() as &dyn FilmSink).collect();
         let total = film.spp();
         let cancel = AtomicBool::new(false);
         let done_spp = AtomicU32::new(samples_done(film));
@@ -326,8 +365,12 @@ impl Session {
         let outcome = std::thread::scope(|s| {
             let worker = s.spawn(|| {
                 let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    let control =
-                        RenderControl { passes: Some(first..end), time_limit, ..RenderControl::new(&cancel, &Silent) };
+                    let control = RenderControl {
+                        passes: Some(first..end),
+                        time_limit,
+                        sinks: &sinks,
+                        ..RenderControl::new(&cancel, &Silent)
+                    };
                     let mut work = || {
                         session.render(film, &control, &mut |f: &Film| {
                             done_spp.store(samples_done(f), Ordering::Relaxed);

@@ -19,6 +19,14 @@ pub struct Scene {
     pub(crate) session: Session,
 }
 
+impl Scene {
+    /// The scene's file name (or "scene" for one made from a dict), a preview's title.
+    pub fn title(&self) -> String {
+        let d = self.session.description();
+        d.source.as_ref().and_then(|p| p.file_name()).map_or("scene".into(), |n| n.to_string_lossy().into_owned())
+    }
+}
+
 /// Reads a scene file; `defines` are (name, value) Mitsuba `<default>` overrides.
 #[pyfunction]
 pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) -> PyResult<Scene> {

@@ -8,7 +8,8 @@
 //! - [`integrators`] estimate radiance along rays of a world; [`render`] schedules passes of
 //!   samples over tiles and threads into a film;
 //! - [`session`] ties these together behind one API, which every front end (the `glint`
-//!   command line, Python) uses.
+//!   command line, Python) uses; [`preview`] holds the live views it feeds as passes land
+//!   (a page in the browser, tev).
 //!
 //! Below them: [`math`], [`sampling`], [`accel`] (BVHs over boxes and triangles),
 //! [`geometry`] (shapes), [`bsdf`] and [`materials`], [`media`] (participating media), [`lights`], [`camera`], [`io`] (images
@@ -28,6 +29,7 @@ pub mod lights;
 pub mod materials;
 pub mod math;
 pub mod media;
+pub mod preview;
 pub mod render;
 pub mod sampling;
 pub mod session;

@@ -25,7 +25,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable, List, Optional, Sequence, Tuple, Union
 
-from .. import RenderResult, Scene, load_file, make_session
+from .. import Preview, RenderResult, Scene, load_file, make_session, show_preview
 from . import _pack, _plan
 from ._driver import Driver, Frame, Progress, write_frame
 
@@ -139,6 +139,7 @@ def render(
     cpus_per_task: int = 1,
     max_retries: int = 5,
     report: Optional[Callable[[Progress], Any]] = None,
+    preview: Union[bool, str] = False,
 ) -> Union[RenderResult, List[RenderResult]]:
     """Renders on Ray and returns what ``glint.render`` returns (a list of them for a
     list of scenes, the frames of an animation, which share the workers).
@@ -154,6 +155,8 @@ def render(
     every ``checkpoint_every`` seconds, at the end and on Ctrl-C (default: the ``resume``
     file). ``cpus_per_task``: CPUs (and threads) per task. ``max_retries``: how often Ray
     runs a task again whose worker died. ``report(Progress)``: after every block.
+    ``preview``: True (or "HOST:PORT") serves the live page of ``glint.render(preview=True)``
+    showing the driver's merged film and each worker's tasks; its Stop acts as Ctrl-C.
     """
     frames_in = list(scene) if isinstance(scene, (list, tuple)) else [scene]
     if not frames_in:
@@ -187,6 +190,12 @@ def render(
         ck = checkpoints[i] if checkpoints[i] is not None else resumes[i]
         frames.append(Frame(sc, name, session, _pack.pack(sc), seed, out_i, ck))
     load_seconds = time.perf_counter() - started
+    live = None
+    if preview is not False and preview is not None:
+        if not isinstance(preview, (bool, str)):
+            raise TypeError(f"preview must be True or an address, not {type(preview).__name__}")
+        live = Preview(None if preview is True else preview, frames[0].name)
+        show_preview(live)
 
     ray = _ray()
     own_ray = not ray.is_initialized()
@@ -195,7 +204,7 @@ def render(
 
         ray.init(address=_address(address), include_dashboard=False, logging_level=logging.WARNING)
     try:
-        options = _Options(tile, passes_per_task, cpus_per_task, max_retries, aovs, checkpoint_every)
+        options = _Options(tile, passes_per_task, cpus_per_task, max_retries, aovs, checkpoint_every, live)
         # Time to load and build the scene on the driver, and to start or reach Ray.
         load = (load_seconds, time.perf_counter() - started - load_seconds)
         results = _run(ray, frames, options, _callback(progress, report), started, load)
@@ -213,6 +222,7 @@ class _Options:
     max_retries: int
     aovs: List[str]
     checkpoint_every: float
+    preview: Any = None
 
 
 def _callback(progress: Optional[Callable[[int, int], Any]], report: Optional[Callable[[Progress], Any]]) -> Any:
@@ -245,7 +255,7 @@ def _run(ray: Any, frames: List[Frame], o: _Options, on_block: Any, started: flo
         ppt = o.passes_per_task or _plan.auto_passes_per_task(passes, tiles * len(frames), slots)
         tasks.extend(_plan.plan(i, f.scene.width, f.scene.height, passes, o.tile, ppt, f.session.blocks()))
     remote = ray.remote(num_cpus=o.cpus_per_task, max_retries=o.max_retries)(render_block)
-    driver = Driver(frames, tasks, remote, o.cpus_per_task, o.aovs, o.checkpoint_every, on_block)
+    driver = Driver(frames, tasks, remote, o.cpus_per_task, o.aovs, o.checkpoint_every, on_block, o.preview)
     already_whole = [f for f in frames if f.tasks_left == 0]
     try:
         totals = driver.run()

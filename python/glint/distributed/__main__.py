@@ -32,6 +32,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-D", dest="define", action="append", default=[], metavar="NAME=VALUE",
                    help="override a Mitsuba <default> value (repeatable)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    p.add_argument("--preview", nargs="?", const=True, default=False, metavar="ADDR",
+                   help="serve a live view of the merged film and the workers in the browser (default "
+                        "127.0.0.1 at a free port, printed); its Stop acts as Ctrl-C")
     return p
 
 
@@ -120,6 +123,7 @@ def main(argv: Optional[List[str]] = None) -> int:
             scene, spp=a.spp, seed=a.seed, out=a.output, address=a.address, tile=a.tile,
             passes_per_task=a.passes_per_task, resume=a.resume, checkpoint=a.checkpoint,
             checkpoint_every=a.checkpoint_every, cpus_per_task=a.cpus_per_task, report=report,
+            preview=a.preview,
         )
     except KeyboardInterrupt:
         bar.finish()

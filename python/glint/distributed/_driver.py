@@ -21,6 +21,8 @@ WINDOW_PER_SLOT = 2
 #: How long the driver waits for a block before it looks at the clock (checkpoints,
 #: progress) and at the cluster's size (nodes that joined or left).
 POLL_SECONDS = 0.25
+#: The live preview shows the merged film at most this often (a copy of the film each time).
+PREVIEW_SECONDS = 0.5
 RESIZE_SECONDS = 2.0
 #: The counters a worker's session reports, added up per frame and in all.
 RAY_COUNTS = dict(rays=0, shadow_rays=0, camera_rays=0, discarded_samples=0)
@@ -78,6 +80,7 @@ class Driver:
         aovs: List[str],
         checkpoint_every: float,
         report: Optional[Callable[[Progress], None]],
+        preview: Any = None,
     ):
         self.frames = frames
         self.queue = list(reversed(tasks))  # popped from the end: the plan's order
@@ -92,6 +95,13 @@ class Driver:
         self.samples_done = 0
         for t in tasks:
             frames[t.frame].tasks_left += 1
+        # The live preview (glint.Preview) and what it shows: the frame a block last came
+        # for, and per worker process its tasks done and when it last sent one.
+        self.preview = preview
+        self.shown_frame = 0
+        self.last_shown = 0.0
+        self.workers: Dict[int, List[float]] = {}
+        self.tasks_total = len(tasks)
 
     def _spp(self, t: Task) -> int:
         """Samples per pixel of the task's passes."""
@@ -134,12 +144,31 @@ class Driver:
                 if now - last_checkpoint >= self.checkpoint_every:
                     self.write_checkpoints()
                     last_checkpoint = now
+                if self.preview is not None:
+                    if self.preview.stop_requested():
+                        raise KeyboardInterrupt  # the Stop button: as Ctrl-C
+                    if ready and now - self.last_shown >= PREVIEW_SECONDS:
+                        self.show(now - start, "rendering")
+                        self.last_shown = now
         except BaseException:
             for ref in self.in_flight:
                 ray.cancel(ref)
             self.in_flight.clear()
             raise
+        if self.preview is not None:
+            self.show(time.perf_counter() - start, "done")
         return self.totals
+
+    def show(self, elapsed: float, state: str) -> None:
+        """Publishes the merged film of the frame last added to, and the worker table."""
+        now = time.perf_counter()
+        self.preview.set_workers([
+            (f"pid {pid}", int(done), self.tasks_total, f"last block {now - last:.1f} s ago")
+            for pid, (done, last) in sorted(self.workers.items())
+        ])
+        rays = self.totals.rays["rays"] + self.totals.rays["shadow_rays"]
+        mrays = rays / max(elapsed, 1e-9) / 1e6
+        self.preview.publish(self.frames[self.shown_frame].session, elapsed, mrays, state)
 
     def _add(self, ref: Any, t: Task) -> None:
         import ray
@@ -162,6 +191,10 @@ class Driver:
         tot.world_builds += int(stats["built"])
         tot.worker_seconds += stats["task_seconds"]
         tot.pids.add(stats["pid"])
+        w = self.workers.setdefault(stats["pid"], [0, 0.0])
+        w[0] += 1
+        w[1] = time.perf_counter()
+        self.shown_frame = t.frame
         for k in RAY_COUNTS:
             tot.rays[k] += stats[k]
             f.rays[k] += stats[k]

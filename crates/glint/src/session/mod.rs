@@ -42,6 +42,7 @@ use crate::describe::SceneDesc;
 use crate::error::{Error, SourceLoc};
 use crate::formats::{read, ReadOptions};
 use crate::integrators::Integrator;
+use crate::preview::{film_spp, FilmSink, RenderProgress};
 use crate::render::{
     read_film, render_passes, write_film, Adaptive, Aov, ContentHash, Film, FilmMeta, PassRequest, Progress, Rect,
     RenderSettings, RenderStats, Schedule,
@@ -82,11 +83,14 @@ pub struct RenderControl<'a> {
     /// No pass starts after this.
     pub time_limit: Option<Duration>,
     pub progress: &'a dyn Progress,
+    /// Live views fed after each pass (the browser preview, tev); one asking to stop stops
+    /// the render as `cancel` does.
+    pub sinks: &'a [&'a dyn FilmSink],
 }
 
 impl<'a> RenderControl<'a> {
     pub fn new(cancel: &'a AtomicBool, progress: &'a dyn Progress) -> RenderControl<'a> {
-        RenderControl { passes: None, adaptive: None, cancel, time_limit: None, progress }
+        RenderControl { passes: None, adaptive: None, cancel, time_limit: None, progress, sinks: &[] }
     }
 }
 
@@ -95,6 +99,8 @@ impl<'a> RenderControl<'a> {
 pub struct RenderReport {
     pub passes: Range<u32>,
     pub cancelled: bool,
+    /// Stopped by a live view's Stop button (then `cancelled` too).
+    pub stopped_by_viewer: bool,
     pub timed_out: bool,
     pub stats: RenderStats,
 }
@@ -234,9 +240,17 @@ impl Session {
         let first = film.passes_done();
         let passes = control.passes.clone().unwrap_or(first..film.pass_count());
         let mut report = RenderReport { passes: passes.start..passes.start, ..Default::default() };
+        for sink in control.sinks {
+            sink.started(film);
+        }
         for pass in passes.clone() {
             if control.cancel.load(Ordering::Relaxed) {
                 report.cancelled = true;
+                break;
+            }
+            if control.sinks.iter().any(|s| s.stop_requested()) {
+                report.cancelled = true;
+                report.stopped_by_viewer = true;
                 break;
             }
             if control.time_limit.is_some_and(|t| start.elapsed() >= t) {
@@ -250,9 +264,22 @@ impl Session {
                 break;
             }
             report.passes.end = pass + 1;
+            if !control.sinks.is_empty() {
+                let progress = render_progress(film, &report, passes.end, start, "rendering");
+                for sink in control.sinks {
+                    sink.pass_done(film, &progress);
+                }
+            }
             after_pass(film)?;
         }
         report.stats.seconds = start.elapsed().as_secs_f64();
+        if !control.sinks.is_empty() {
+            let state = if report.cancelled { "stopped" } else { "done" };
+            let progress = render_progress(film, &report, passes.end, start, state);
+            for sink in control.sinks {
+                sink.finished(film, &progress);
+            }
+        }
         Ok(report)
     }
 
@@ -393,6 +420,30 @@ pub fn merge_films(paths: &[PathBuf]) -> Result<(Film, RenderJob, u64), Error> {
         film.merge(&other).map_err(|e| Error::at(&loc, e))?;
     }
     Ok((film, job, hash))
+}
+
+/// How far a render call has come, for live views: `last` is the pass it ends before.
+fn render_progress(
+    film: &Film,
+    report: &RenderReport,
+    last: u32,
+    start: Instant,
+    state: &'static str,
+) -> RenderProgress {
+    let elapsed = start.elapsed().as_secs_f64();
+    let done = report.passes.len() as f64;
+    let left = last.saturating_sub(report.passes.end) as f64;
+    let s = &report.stats;
+    RenderProgress {
+        spp: film_spp(film),
+        target_spp: film.spp(),
+        passes_done: film.passes_done(),
+        pass_count: film.pass_count(),
+        elapsed,
+        eta: (done > 0.0).then(|| elapsed / done * left),
+        mrays_per_second: (s.rays + s.shadow_rays) as f64 / elapsed.max(1e-9) / 1e6,
+        state,
+    }
 }
 
 /// What rendering one pass of a session needs.
