@@ -17,10 +17,18 @@ pub fn info_cmd(a: SceneArgs) -> Result<(), glint::Error> {
 fn print_info(a: &SceneArgs, s: &glint::world::World, load_s: f64) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
     let spheres = s.instances().iter().filter(|i| matches!(i.shape, ShapeRef::Sphere(_))).count();
-    let mesh_instances = s.instances().len() - spheres;
+    let curve_sets = s.curves().len();
+    let mesh_instances = s.instances().len() - spheres - curve_sets;
     let unique_tris: usize = s.meshes().iter().map(|m| m.indices.len()).sum();
     writeln!(out, "scene            {}", a.scene.display())?;
-    writeln!(out, "shapes           {} ({} mesh instances, {} spheres)", s.instances().len(), mesh_instances, spheres)?;
+    writeln!(
+        out,
+        "shapes           {} ({} mesh instances, {} spheres, {} curve sets)",
+        s.instances().len(),
+        mesh_instances,
+        spheres,
+        curve_sets
+    )?;
     writeln!(out, "meshes           {} unique, {} triangles stored", s.meshes().len(), unique_tris)?;
     writeln!(out, "triangles        {} (instanced)", s.triangle_count())?;
     writeln!(out, "lights           {}", s.lights().len())?;
@@ -53,5 +61,19 @@ fn print_info(a: &SceneArgs, s: &glint::world::World, load_s: f64) -> std::io::R
     }
     writeln!(out, "BVH memory       {} bytes ({:.2} MiB)", total_bytes, total_bytes as f64 / 1048576.0)?;
     writeln!(out, "mesh memory      {} bytes ({:.2} MiB)", mesh_bytes, mesh_bytes as f64 / 1048576.0)?;
+    for (i, c) in s.curves().iter().enumerate() {
+        let bytes = c.memory_bytes();
+        writeln!(
+            out,
+            "curves {:<4}      {}: {} curves, {} segments, {} BVH primitives, {} bytes ({:.1} per segment, points and BVH included)",
+            i,
+            c.basis().plugin(),
+            c.curve_count(),
+            c.segment_count(),
+            c.primitive_count(),
+            bytes,
+            bytes as f64 / c.segment_count().max(1) as f64
+        )?;
+    }
     Ok(())
 }

@@ -4,12 +4,12 @@
 
 use crate::accel::BvhSplit;
 use crate::camera::Camera;
-use crate::geometry::{Cylinder, SdfGrid, SdfGridData, SdfNormals, Sphere, TriangleMesh};
+use crate::geometry::{CurveBasis, Curves, Cylinder, SdfGrid, SdfGridData, SdfNormals, Sphere, TriangleMesh};
 use crate::io::{obj, ply, serialized};
 use crate::lights::LightSelection;
 use crate::lights::{scene_radius, AreaEmission, EnvMap, Light, MeshEmitter};
 use crate::materials::{Bitmap, Material, MaterialKind, Texture};
-use crate::math::{Aabb, Rgb, Transform, Vec3};
+use crate::math::{vec3, Aabb, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
 use crate::world::{Instance, ShapeRef, World};
 use std::collections::HashMap;
@@ -116,6 +116,7 @@ pub struct WorldBuilder {
     spheres: Vec<Sphere>,
     cylinders: Vec<Cylinder>,
     sdf_grids: Vec<SdfGrid>,
+    curves: Vec<Curves>,
     /// SDF grids by file, loaded once however often they are placed.
     sdf_data: HashMap<std::path::PathBuf, Arc<SdfGridData>>,
     instances: Vec<Instance>,
@@ -136,6 +137,7 @@ impl WorldBuilder {
             spheres: Vec::new(),
             cylinders: Vec::new(),
             sdf_grids: Vec::new(),
+            curves: Vec::new(),
             sdf_data: HashMap::new(),
             instances: Vec::new(),
             materials: Vec::new(),
@@ -405,6 +407,43 @@ impl WorldBuilder {
         Ok(())
     }
 
+    /// Places the curves of a Mitsuba curve file: `to_world` moves the control points, not
+    /// their radii (as in Mitsuba).
+    pub fn add_curves(
+        &mut self,
+        file: &std::path::Path,
+        basis: CurveBasis,
+        to_world: &Transform,
+        material: u32,
+    ) -> Result<(), String> {
+        let start = Instant::now();
+        let data = crate::io::curves::read_curves(file, basis)?;
+        let points = data
+            .points
+            .iter()
+            .map(|p| {
+                let q = to_world.point(vec3(p[0], p[1], p[2]));
+                [q.x, q.y, q.z, p[3]]
+            })
+            .collect();
+        let curves = Curves::new(basis, points, data.curve_starts, self.split)
+            .map_err(|e| format!("{}: {e}", file.display()))?;
+        self.build_seconds += start.elapsed().as_secs_f64();
+        let id = self.curves.len() as u32;
+        let bounds = curves.bounds();
+        self.curves.push(curves);
+        self.instances.push(Instance {
+            shape: ShapeRef::Curves(id),
+            to_world: None,
+            material,
+            light: None,
+            flip_normals: false,
+            bounds,
+            media: MediumBoundary::default(),
+        });
+        Ok(())
+    }
+
     pub fn add_light(&mut self, light: Light) {
         self.lights.push(PendingLight::Ready(light));
     }
@@ -459,6 +498,7 @@ impl WorldBuilder {
             spheres: self.spheres,
             cylinders: self.cylinders,
             sdf_grids: self.sdf_grids,
+            curves: self.curves,
             instances: self.instances,
             top: Default::default(),
             materials: self.materials,

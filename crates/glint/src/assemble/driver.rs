@@ -11,9 +11,9 @@ use super::builder::{bake, environment_lights, read_mesh_file};
 use super::{add_light, camera, material_id, material_kind, mesh_loc, transform_of, validate, TextureCache};
 use super::{BuildOptions, LoadedGroup, WorldBuilder};
 use crate::accel::BvhSplit;
-use crate::describe::{Emission, Geometry, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc, ShapeDesc};
+use crate::describe::{CurveBasisDesc, Emission, Geometry, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc, ShapeDesc};
 use crate::error::{Error, SourceLoc};
-use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, SdfNormals, TriangleMesh};
+use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, CurveBasis, SdfNormals, TriangleMesh};
 use crate::lights::{AreaEmission, Light};
 use crate::materials::Material;
 use crate::math::Transform;
@@ -235,6 +235,17 @@ fn add_shape(
                     emission,
                 )
                 .map_err(|e| Error::at(&s.loc, e));
+        }
+        Geometry::Curves { file, basis } => {
+            check_attributes(desc, s, None)?;
+            let basis = match basis {
+                CurveBasisDesc::Linear => CurveBasis::Linear,
+                CurveBasisDesc::BSpline => CurveBasis::BSpline,
+            };
+            if emission.is_some() || s.flip_normals {
+                return Err(Error::at(&s.loc, "curves can neither emit light nor flip their normals"));
+            }
+            return b.add_curves(file, basis, &to_world, material).map_err(|e| Error::at(&s.loc, e));
         }
         g => (Source::Shape { index: place.index, geometry: geometry_hash(g) }, false),
     };

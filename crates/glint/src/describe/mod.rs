@@ -408,6 +408,22 @@ pub enum Geometry {
         file: PathBuf,
         normals: SdfNormalsDesc,
     },
+    /// Round curves read from a Mitsuba curve file (x y z radius per line, a blank line
+    /// between curves); the transform moves the points, not the radii.
+    Curves {
+        file: PathBuf,
+        basis: CurveBasisDesc,
+    },
+}
+
+/// How a curve file's control points make curves (Mitsuba's plugin).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CurveBasisDesc {
+    /// `linearcurve`: straight segments, round joints and caps.
+    Linear,
+    /// `bsplinecurve`: a uniform cubic B-spline, open ends.
+    BSpline,
 }
 
 /// How an SDF grid's shading normals are computed (Mitsuba's `normals`).
@@ -541,7 +557,9 @@ impl SceneDesc {
             add(&m.file);
         }
         for s in &self.shapes {
-            if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } = &s.geometry {
+            if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } | Geometry::Curves { file, .. } =
+                &s.geometry
+            {
                 add(file);
             }
             if let Some(Emission { radiance: TextureDesc::Bitmap { file, .. }, .. }) = &s.emission {
@@ -585,7 +603,9 @@ impl SceneDesc {
             map(&mut m.file)?;
         }
         for s in &mut self.shapes {
-            if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } = &mut s.geometry {
+            if let Geometry::MeshFile { file, .. } | Geometry::SdfGrid { file, .. } | Geometry::Curves { file, .. } =
+                &mut s.geometry
+            {
                 map(file)?;
             }
             if let Some(Emission { radiance: TextureDesc::Bitmap { file, .. }, .. }) = &mut s.emission {

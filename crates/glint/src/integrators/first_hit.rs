@@ -97,6 +97,13 @@ pub fn closest_hit_cost(scene: &World, ray: &Ray) -> u64 {
                     }
                     None => false,
                 },
+                ShapeRef::Curves(c) => match scene.curves[c as usize].intersect(r) {
+                    Some(h) => {
+                        r.t_max = h.t;
+                        true
+                    }
+                    None => false,
+                },
             }
         });
     }

@@ -1,5 +1,6 @@
 //! File input and output: images and meshes.
 
+pub mod curves;
 pub mod image_io;
 pub mod layers;
 pub mod obj;

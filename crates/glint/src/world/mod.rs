@@ -9,7 +9,7 @@
 
 use crate::accel::{prefetch, BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
-use crate::geometry::{Cylinder, SdfGrid, Sphere, TriangleMesh};
+use crate::geometry::{CurveHit, Curves, Cylinder, SdfGrid, Sphere, TriangleMesh};
 use crate::lights::{Light, LightSelection};
 use crate::materials::{Material, MaterialKind, TexturePoint};
 use crate::math::{Aabb, Frame, Ray, Rgb, Transform, Vec3};
@@ -23,6 +23,9 @@ pub enum ShapeRef {
     Sphere(u32),
     Cylinder(u32),
     SdfGrid(u32),
+    /// A set of curves; a hit's `prim` is its segment's first control point, `b1` the
+    /// segment parameter.
+    Curves(u32),
 }
 
 #[derive(Clone, Debug)]
@@ -93,6 +96,7 @@ pub struct World {
     pub(crate) spheres: Vec<Sphere>,
     pub(crate) cylinders: Vec<Cylinder>,
     pub(crate) sdf_grids: Vec<SdfGrid>,
+    pub(crate) curves: Vec<Curves>,
     pub(crate) instances: Vec<Instance>,
     /// Over instances: the binary reference and the 8-wide tree that traversal uses.
     pub(crate) top: TopLevelBvh,
@@ -322,6 +326,7 @@ impl World {
             ShapeRef::SdfGrid(g) => {
                 self.sdf_grids[g as usize].intersect(r).map(|(t, prim)| Hit { t, instance: 0, prim, b1: 0.0, b2: 0.0 })
             }
+            ShapeRef::Curves(c) => self.curves[c as usize].intersect(r).map(|h| curve_hit(h, 0)),
         }
     }
 
@@ -352,6 +357,7 @@ impl World {
                 ShapeRef::Sphere(s) => self.spheres[s as usize].intersect(r).is_some(),
                 ShapeRef::Cylinder(c) => self.cylinders[c as usize].intersect(r).is_some(),
                 ShapeRef::SdfGrid(g) => self.sdf_grids[g as usize].occluded(r),
+                ShapeRef::Curves(c) => self.curves[c as usize].occluded(r),
             }
         })
     }
@@ -396,6 +402,9 @@ impl World {
                     b1: 0.0,
                     b2: 0.0,
                 }),
+                ShapeRef::Curves(c) => {
+                    self.curves[c as usize].intersect_brute_force(&r).map(|h| curve_hit(h, i as u32))
+                }
             };
             if let Some(h) = h {
                 r.t_max = h.t;
@@ -411,7 +420,7 @@ impl World {
     pub fn texture_point(&self, si: &SurfaceInteraction) -> TexturePoint<'_> {
         let mesh = self.instances.get(si.instance as usize).and_then(|inst| match inst.shape {
             ShapeRef::Mesh(m) => self.meshes.get(m as usize).map(|m| &**m),
-            ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) => None,
+            ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) | ShapeRef::Curves(_) => None,
         });
         TexturePoint { uv: si.uv, prim: si.prim, bary: si.bary, mesh }
     }
@@ -527,6 +536,10 @@ impl World {
                 let q = self.sdf_grids[g as usize].point(ray, hit.t, hit.prim);
                 (q.p, q.n, Some(q.shading_n), [0.0, 0.0], Vec3::ZERO, Vec3::ZERO)
             }
+            ShapeRef::Curves(c) => {
+                let q = self.curves[c as usize].point(ray, &CurveHit { t: hit.t, point: hit.prim, v: hit.b1 });
+                (q.p, q.n, None, q.uv, q.dpdu, q.dpdv)
+            }
         };
         ng = ng.normalize();
         if inst.flip_normals {
@@ -577,6 +590,9 @@ impl World {
     pub fn sdf_grids(&self) -> &[SdfGrid] {
         &self.sdf_grids
     }
+    pub fn curves(&self) -> &[Curves] {
+        &self.curves
+    }
     pub fn instances(&self) -> &[Instance] {
         &self.instances
     }
@@ -614,10 +630,16 @@ impl World {
             .iter()
             .map(|i| match i.shape {
                 ShapeRef::Mesh(m) => self.meshes[m as usize].indices.len(),
-                ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) => 0,
+                ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) | ShapeRef::SdfGrid(_) | ShapeRef::Curves(_) => 0,
             })
             .sum()
     }
+}
+
+/// The traversal hit of a curve: `prim` its segment's first control point, `b1` the
+/// segment parameter.
+fn curve_hit(h: CurveHit, instance: u32) -> Hit {
+    Hit { t: h.t, instance, prim: h.point, b1: h.v, b2: 0.0 }
 }
 
 /// dp/du and dp/dv of a triangle from its uvs, as Mitsuba computes them; where the uvs are

@@ -17,8 +17,8 @@ pub mod xml;
 
 use super::Define;
 use crate::describe::{
-    Aov, CameraDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc, MaterialRef,
-    MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
+    Aov, CameraDesc, CurveBasisDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
+    MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
     VolpathSettings,
 };
 use crate::describe::{CropWindow, FovAxis, PixelFilter, Projection, SamplerKind};
@@ -409,6 +409,17 @@ impl<'a> Reader<'a> {
                 self.note::<()>(Err(el.err("sdfgrid: flip_normals is not supported (Mitsuba ignores it)")));
             }
         }
+        if ty == "linearcurve" || ty == "bsplinecurve" {
+            if emission.is_some() {
+                self.note::<()>(Err(el.err(format!("{ty}: emitting curves are not supported"))));
+            }
+            if media != ShapeMedia::default() {
+                self.note::<()>(Err(el.err(format!("{ty}: interior/exterior media are not supported"))));
+            }
+            if flip_normals {
+                self.note::<()>(Err(el.err(format!("{ty}: flip_normals is not supported"))));
+            }
+        }
         // Mitsuba gives a shape without a BSDF a diffuse 0.5 one, and an emitting shape a
         // black one (its light does not reflect light).
         let material = match (material, &emission) {
@@ -463,6 +474,11 @@ impl<'a> Reader<'a> {
                     }
                 };
                 Geometry::SdfGrid { file: self.resolve_file(el, file), normals }
+            }
+            "linearcurve" | "bsplinecurve" => {
+                let file = p.string("filename").ok_or_else(|| el.err(format!("shape '{ty}' needs 'filename'")))?;
+                let basis = if ty == "linearcurve" { CurveBasisDesc::Linear } else { CurveBasisDesc::BSpline };
+                Geometry::Curves { file: self.resolve_file(el, file), basis }
             }
             other => return Err(el.err(format!("shape plugin '{other}' is not supported"))),
         };
