@@ -7,6 +7,7 @@ use glint::bsdf::{
     fresnel_dielectric, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong, PlasticParams,
     Principled, PrincipledInputs, PrincipledRates,
 };
+use glint::bsdf::{Diffuse, RoughConductor, RoughDielectric};
 use glint::math::{rgb, Rgb, Vec3};
 use glint::sampling::{warp, Rng};
 
@@ -17,36 +18,54 @@ fn bsdfs() -> Vec<(&'static str, Bsdf)> {
     let beckmann_aniso = Microfacet::anisotropic(MicrofacetKind::Beckmann, 0.6, 0.15);
     let gold = (rgb(0.143, 0.375, 1.442), rgb(3.983, 2.386, 1.603));
     vec![
-        ("diffuse", Bsdf::Diffuse { reflectance: rgb(0.8, 0.5, 0.2) }),
+        ("diffuse", Bsdf::Diffuse(Diffuse { reflectance: rgb(0.8, 0.5, 0.2) })),
         ("phong", Bsdf::Phong(Phong { kd: Rgb::splat(0.4), ks: Rgb::splat(0.5), exponent: 20.0 })),
-        ("rough conductor GGX", Bsdf::RoughConductor { dist: ggx, eta: gold.0, k: gold.1, specular: Rgb::WHITE }),
+        (
+            "rough conductor GGX",
+            Bsdf::RoughConductor(RoughConductor { dist: ggx, eta: gold.0, k: gold.1, specular: Rgb::WHITE }),
+        ),
         (
             "rough conductor Beckmann",
-            Bsdf::RoughConductor { dist: beckmann, eta: gold.0, k: gold.1, specular: Rgb::WHITE },
+            Bsdf::RoughConductor(RoughConductor { dist: beckmann, eta: gold.0, k: gold.1, specular: Rgb::WHITE }),
         ),
         (
             "rough dielectric GGX",
-            Bsdf::RoughDielectric { dist: ggx, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+            Bsdf::RoughDielectric(RoughDielectric { dist: ggx, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE }),
         ),
         (
             "rough dielectric Beckmann",
-            Bsdf::RoughDielectric { dist: beckmann, eta: 1.33, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+            Bsdf::RoughDielectric(RoughDielectric {
+                dist: beckmann,
+                eta: 1.33,
+                reflect: Rgb::WHITE,
+                transmit: Rgb::WHITE,
+            }),
         ),
         (
             "anisotropic rough conductor GGX",
-            Bsdf::RoughConductor { dist: ggx_aniso, eta: gold.0, k: gold.1, specular: Rgb::WHITE },
+            Bsdf::RoughConductor(RoughConductor { dist: ggx_aniso, eta: gold.0, k: gold.1, specular: Rgb::WHITE }),
         ),
         (
             "anisotropic rough conductor Beckmann",
-            Bsdf::RoughConductor { dist: beckmann_aniso, eta: gold.0, k: gold.1, specular: Rgb::WHITE },
+            Bsdf::RoughConductor(RoughConductor { dist: beckmann_aniso, eta: gold.0, k: gold.1, specular: Rgb::WHITE }),
         ),
         (
             "anisotropic rough dielectric GGX",
-            Bsdf::RoughDielectric { dist: ggx_aniso, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+            Bsdf::RoughDielectric(RoughDielectric {
+                dist: ggx_aniso,
+                eta: 1.5,
+                reflect: Rgb::WHITE,
+                transmit: Rgb::WHITE,
+            }),
         ),
         (
             "anisotropic rough dielectric Beckmann",
-            Bsdf::RoughDielectric { dist: beckmann_aniso, eta: 1.33, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+            Bsdf::RoughDielectric(RoughDielectric {
+                dist: beckmann_aniso,
+                eta: 1.33,
+                reflect: Rgb::WHITE,
+                transmit: Rgb::WHITE,
+            }),
         ),
         (
             "pplastic",
@@ -75,7 +94,12 @@ fn bsdfs() -> Vec<(&'static str, Bsdf)> {
                 0.35,
                 BlendPart { bsdf: principled(0.0), two_sided: true },
                 BlendPart {
-                    bsdf: Bsdf::RoughConductor { dist: ggx, eta: gold.0, k: gold.1, specular: Rgb::WHITE },
+                    bsdf: Bsdf::RoughConductor(RoughConductor {
+                        dist: ggx,
+                        eta: gold.0,
+                        k: gold.1,
+                        specular: Rgb::WHITE,
+                    }),
                     two_sided: false,
                 },
             )),
@@ -103,7 +127,7 @@ fn principled(spec_trans: f32) -> Bsdf {
 
 fn eta_of(bsdf: &Bsdf, w: Vec3) -> f32 {
     match bsdf {
-        Bsdf::RoughDielectric { eta, .. } if w.z < 0.0 => *eta,
+        Bsdf::RoughDielectric(RoughDielectric { eta, .. }) if w.z < 0.0 => *eta,
         Bsdf::Principled(p) if w.z < 0.0 && p.spec_trans > 0.0 => p.eta,
         _ => 1.0,
     }
@@ -124,7 +148,9 @@ fn bsdfs_are_reciprocal() {
             // their digits and the two sides cannot agree closely.
             let h = (wi * eta_of(&bsdf, wi) + wo * eta_of(&bsdf, wo)).normalize();
             let cos_t = match &bsdf {
-                Bsdf::RoughDielectric { eta, .. } => fresnel_dielectric(wo.dot(h) * h.z.signum(), *eta).cos_t,
+                Bsdf::RoughDielectric(RoughDielectric { eta, .. }) => {
+                    fresnel_dielectric(wo.dot(h) * h.z.signum(), *eta).cos_t
+                }
                 Bsdf::Principled(p) if p.spec_trans > 0.0 => fresnel_dielectric(wo.dot(h) * h.z.signum(), p.eta).cos_t,
                 _ => 1.0,
             };

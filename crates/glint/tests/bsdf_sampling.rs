@@ -10,6 +10,7 @@ use glint::bsdf::{
     normal_map_frame, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong, PlasticParams,
     Principled, PrincipledInputs, PrincipledRates, ShadedBsdf,
 };
+use glint::bsdf::{Conductor, Diffuse, RoughConductor, RoughDielectric};
 use glint::math::vec3;
 use glint::math::{rgb, Rgb};
 use rayon::prelude::*;
@@ -61,7 +62,7 @@ fn cases() -> Vec<BsdfCase> {
     let gold = (rgb(0.143, 0.375, 1.442), rgb(3.983, 2.386, 1.603));
     let mut v = Vec::new();
     for wo in [0.0, 45.0, 85.0] {
-        v.push(case("diffuse", Bsdf::Diffuse { reflectance: rgb(0.8, 0.5, 0.2) }, wo, true));
+        v.push(case("diffuse", Bsdf::Diffuse(Diffuse { reflectance: rgb(0.8, 0.5, 0.2) }), wo, true));
     }
     for (exponent, wo) in [(10.0, 0.0), (10.0, 60.0), (200.0, 30.0), (200.0, 80.0)] {
         let p = Phong { kd: Rgb::splat(0.4), ks: Rgb::splat(0.5), exponent };
@@ -76,7 +77,7 @@ fn cases() -> Vec<BsdfCase> {
         ("Beckmann 0.7", beckmann(0.7)),
     ] {
         for wo in [0.0, 45.0, 80.0] {
-            let b = Bsdf::RoughConductor { dist, eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+            let b = Bsdf::RoughConductor(RoughConductor { dist, eta: gold.0, k: gold.1, specular: Rgb::WHITE });
             v.push(case(&format!("rough conductor {name}"), b, wo, false));
         }
     }
@@ -85,7 +86,8 @@ fn cases() -> Vec<BsdfCase> {
         [("GGX 0.1", ggx(0.1)), ("GGX 0.5", ggx(0.5)), ("Beckmann 0.1", beckmann(0.1)), ("Beckmann 0.5", beckmann(0.5))]
     {
         for wo in [30.0, 75.0, 150.0, 110.0] {
-            let b = Bsdf::RoughDielectric { dist, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE };
+            let b =
+                Bsdf::RoughDielectric(RoughDielectric { dist, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE });
             v.push(case(&format!("rough dielectric {name}"), b, wo, false));
         }
     }
@@ -96,11 +98,12 @@ fn cases() -> Vec<BsdfCase> {
         ("Beckmann 0.4x0.1", aniso(MicrofacetKind::Beckmann, 0.4, 0.1)),
     ] {
         for (theta, phi) in [(0.0, 0.0), (50.0, 30.0), (80.0, 120.0)] {
-            let b = Bsdf::RoughConductor { dist, eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+            let b = Bsdf::RoughConductor(RoughConductor { dist, eta: gold.0, k: gold.1, specular: Rgb::WHITE });
             v.push(azimuth_case(&format!("rough conductor {name}"), b, theta, phi));
         }
         for (theta, phi) in [(40.0, 60.0), (140.0, 200.0)] {
-            let b = Bsdf::RoughDielectric { dist, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE };
+            let b =
+                Bsdf::RoughDielectric(RoughDielectric { dist, eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE });
             v.push(azimuth_case(&format!("rough dielectric {name}"), b, theta, phi));
         }
     }
@@ -136,9 +139,10 @@ fn cases() -> Vec<BsdfCase> {
     // Normal- and bump-mapped: the BSDF in a tilted frame, with the shadowing term.
     for (tilt, n) in [("30°", vec3(0.5, 0.0, 0.866)), ("50° skew", vec3(-0.5, 0.55, 0.67))] {
         for wo in [10.0, 60.0] {
-            let d = Bsdf::Diffuse { reflectance: rgb(0.8, 0.5, 0.2) };
+            let d = Bsdf::Diffuse(Diffuse { reflectance: rgb(0.8, 0.5, 0.2) });
             v.push(tilted(&format!("diffuse tilted {tilt}"), d, n, wo));
-            let m = Bsdf::RoughConductor { dist: ggx(0.3), eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+            let m =
+                Bsdf::RoughConductor(RoughConductor { dist: ggx(0.3), eta: gold.0, k: gold.1, specular: Rgb::WHITE });
             v.push(tilted(&format!("rough conductor GGX 0.3 tilted {tilt}"), m, n, wo));
         }
     }
@@ -210,8 +214,9 @@ fn principled_and_blend_cases(v: &mut Vec<BsdfCase>) {
         v.push(case("principled spec_trans 0.7", glassy.clone(), wo, false));
     }
     let gold = (rgb(0.143, 0.375, 1.442), rgb(3.983, 2.386, 1.603));
-    let rough_gold = Bsdf::RoughConductor { dist: ggx(0.3), eta: gold.0, k: gold.1, specular: Rgb::WHITE };
-    let diffuse = Bsdf::Diffuse { reflectance: rgb(0.8, 0.5, 0.2) };
+    let rough_gold =
+        Bsdf::RoughConductor(RoughConductor { dist: ggx(0.3), eta: gold.0, k: gold.1, specular: Rgb::WHITE });
+    let diffuse = Bsdf::Diffuse(Diffuse { reflectance: rgb(0.8, 0.5, 0.2) });
     for wo in [10.0, 70.0] {
         v.push(case(
             "blend 0.3 diffuse / rough gold",
@@ -222,12 +227,17 @@ fn principled_and_blend_cases(v: &mut Vec<BsdfCase>) {
     }
     // A two-sided part seen from below: the diffuse part scatters, the gold one does not.
     v.push(case("blend 0.5 two-sided diffuse / rough gold", blend(0.5, diffuse, rough_gold, true), 120.0, false));
-    let mirror = Bsdf::Conductor { eta: gold.0, k: gold.1, specular: Rgb::WHITE };
+    let mirror = Bsdf::Conductor(Conductor { eta: gold.0, k: gold.1, specular: Rgb::WHITE });
     let plastic = Bsdf::Plastic(PlasticParams::new(rgb(0.6, 0.3, 0.1), Rgb::WHITE, 1.5, Some(ggx(0.3))));
     for wo in [0.0, 60.0] {
         v.push(case("blend 0.4 mirror / rough plastic", blend(0.4, mirror.clone(), plastic.clone(), false), wo, false));
     }
-    let glass = Bsdf::RoughDielectric { dist: beckmann(0.3), eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE };
+    let glass = Bsdf::RoughDielectric(RoughDielectric {
+        dist: beckmann(0.3),
+        eta: 1.5,
+        reflect: Rgb::WHITE,
+        transmit: Rgb::WHITE,
+    });
     for wo in [40.0, 140.0] {
         v.push(case("blend 0.6 principled / rough glass", blend(0.6, glassy.clone(), glass.clone(), false), wo, false));
     }
@@ -365,7 +375,9 @@ fn mean_sample_weight_matches_integrated_eval() {
 
 #[test]
 fn quadrature_is_exact_on_the_diffuse_lobe() {
-    for c in checked().iter().filter(|c| c.case.bsdf.tilt.is_none() && matches!(c.case.bsdf.bsdf, Bsdf::Diffuse { .. }))
+    for c in checked()
+        .iter()
+        .filter(|c| c.case.bsdf.tilt.is_none() && matches!(c.case.bsdf.bsdf, Bsdf::Diffuse(Diffuse { .. })))
     {
         let albedo = (0.8 + 0.5 + 0.2) / 3.0;
         assert!((c.integrals.pdf_total() - 1.0).abs() < QUADRATURE_TOLERANCE, "{}", c.integrals.pdf_total());

@@ -12,7 +12,7 @@
 //! The parts live behind a `Box` (a blend is built per hit, the one material kind that
 //! allocates); every other BSDF stays inline.
 
-use super::{Bsdf, BsdfSample};
+use super::{Bsdf, BsdfSample, Scatter};
 use crate::math::{Rgb, Vec3};
 
 #[derive(Clone, Debug)]
@@ -79,16 +79,18 @@ impl BlendBsdf {
     fn weights(&self) -> [f32; 2] {
         [1.0 - self.weight, self.weight]
     }
+}
 
-    pub fn is_delta(&self) -> bool {
+impl Scatter for BlendBsdf {
+    fn is_delta(&self) -> bool {
         self.parts.iter().all(|p| p.bsdf.is_delta())
     }
 
-    pub fn has_delta_lobe(&self) -> bool {
+    fn has_delta_lobe(&self) -> bool {
         self.parts.iter().any(|p| p.bsdf.has_delta_lobe())
     }
 
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         let [a, b] = self.weights();
         let mut v = Rgb::BLACK;
         if a > 0.0 {
@@ -100,7 +102,7 @@ impl BlendBsdf {
         v
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let [a, b] = self.weights();
         let mut p = 0.0;
         if a > 0.0 {
@@ -112,7 +114,7 @@ impl BlendBsdf {
         p
     }
 
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
         let w = self.weight;
         // Mitsuba: the first part when u_lobe > w, with u_lobe rescaled to [0, 1).
         let (chosen, other, u_lobe) = if w <= 0.0 || (w < 1.0 && u_lobe > w) {
@@ -139,7 +141,7 @@ impl BlendBsdf {
         Some(s)
     }
 
-    pub fn diffuse_reflectance(&self) -> Rgb {
+    fn diffuse_reflectance(&self) -> Rgb {
         let [a, b] = self.weights();
         self.parts[0].bsdf.diffuse_reflectance() * a + self.parts[1].bsdf.diffuse_reflectance() * b
     }

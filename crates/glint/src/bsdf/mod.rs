@@ -13,24 +13,40 @@
 //! - Radiance is transported (camera paths), so refraction scales by (η_i/η_t)².
 //!
 //! A `Bsdf` is the material evaluated at one point: textures already looked up.
+//!
+//! # Adding a BSDF
+//! Write its type in a module of its own with an `impl Scatter` (the compiler names any
+//! method it lacks), and add one line to the `bsdfs!` list below: that line makes the
+//! [`Bsdf`] variant, its dispatch and its `From` conversion.
 
 mod blend;
+mod conductor;
+mod dielectric;
+mod diffuse;
 mod fresnel;
 mod microfacet;
+mod null;
 mod perturbed;
 mod phong;
+mod plastic;
+mod pplastic;
 mod principled;
 
 pub use crate::describe::principled_eta_of_specular;
 pub use blend::{BlendBsdf, BlendPart};
+pub use conductor::{Conductor, RoughConductor};
+pub use dielectric::{Dielectric, RoughDielectric, ThinDielectric};
+pub use diffuse::Diffuse;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
 pub use microfacet::{Microfacet, MicrofacetKind};
+pub use null::{Black, Null};
 pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
 pub use phong::Phong;
+pub use plastic::PlasticParams;
+pub use pplastic::PPlasticParams;
 pub use principled::{principled_alphas, AnisoGgx, Principled, PrincipledInputs, PrincipledRates};
 
-use crate::math::{Rgb, Vec3, INV_PI};
-use crate::sampling::warp;
+use crate::math::{Rgb, Vec3};
 
 impl BsdfSample {
     /// A non-delta sample of direction `wi` for a BSDF whose `eval` and `pdf` give `value`
@@ -57,215 +73,109 @@ pub struct BsdfSample {
     pub eta: f32,
 }
 
-/// Not `Copy`: a blend owns its two parts (see `blend.rs`); every other variant is plain data.
-#[derive(Clone, Debug)]
-pub enum Bsdf {
+/// What every BSDF answers, in the local shading frame (see the conventions above). No
+/// method has a default, so that a new BSDF states each answer.
+pub trait Scatter {
+    /// True when every lobe is a delta: light sampling is pointless there.
+    fn is_delta(&self) -> bool;
+
+    /// True when the BSDF has a delta lobe (beside smooth ones, or alone).
+    fn has_delta_lobe(&self) -> bool;
+
+    /// The BSDF times |cos θi|.
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb;
+
+    /// The solid-angle density with which `sample` produces `wi` (0 for delta lobes).
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+
+    /// Samples `wi` given `wo`. `u_lobe` chooses among lobes, `u` drives the direction.
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample>;
+
+    /// Fraction of light reflected diffusely (the Whitted integrator's mix and the albedo
+    /// guide); the delta directions themselves come from `sample`.
+    fn diffuse_reflectance(&self) -> Rgb;
+}
+
+/// Makes the closed [`Bsdf`] enum from one list of `Variant(Type)`, each type a
+/// [`Scatter`]: the enum, its static dispatch of every `Scatter` method (one arm per
+/// variant, no wildcard) and `From<Type> for Bsdf`.
+macro_rules! bsdfs {
+    ($($(#[doc = $doc:literal])* $variant:ident($ty:ty),)+) => {
+        /// Not `Copy`: a blend owns its two parts (see `blend.rs`); every other variant is
+        /// plain data.
+        #[derive(Clone, Debug)]
+        pub enum Bsdf {
+            $($(#[doc = $doc])* $variant($ty),)+
+        }
+
+        // Inherent, so that callers of a `Bsdf` need not import `Scatter`.
+        impl Bsdf {
+            /// See [`Scatter::is_delta`].
+            pub fn is_delta(&self) -> bool {
+                match self { $(Bsdf::$variant(b) => b.is_delta(),)+ }
+            }
+
+            /// See [`Scatter::has_delta_lobe`].
+            pub fn has_delta_lobe(&self) -> bool {
+                match self { $(Bsdf::$variant(b) => b.has_delta_lobe(),)+ }
+            }
+
+            /// See [`Scatter::eval`].
+            pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+                match self { $(Bsdf::$variant(b) => b.eval(wo, wi),)+ }
+            }
+
+            /// See [`Scatter::pdf`].
+            pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+                match self { $(Bsdf::$variant(b) => b.pdf(wo, wi),)+ }
+            }
+
+            /// See [`Scatter::sample`].
+            pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+                match self { $(Bsdf::$variant(b) => b.sample(wo, u_lobe, u),)+ }
+            }
+
+            /// See [`Scatter::diffuse_reflectance`].
+            pub fn diffuse_reflectance(&self) -> Rgb {
+                match self { $(Bsdf::$variant(b) => b.diffuse_reflectance(),)+ }
+            }
+        }
+
+        $(impl From<$ty> for Bsdf {
+            fn from(b: $ty) -> Bsdf {
+                Bsdf::$variant(b)
+            }
+        })+
+    };
+}
+
+bsdfs! {
     /// Lambertian reflection.
-    Diffuse { reflectance: Rgb },
+    Diffuse(Diffuse),
     /// Diffuse plus a normalised Phong lobe (the Whitted integrator's glossy term).
     Phong(Phong),
     /// Perfectly smooth metal with complex index of refraction per channel.
-    Conductor { eta: Rgb, k: Rgb, specular: Rgb },
+    Conductor(Conductor),
     /// Microfacet metal (GGX or Beckmann).
-    RoughConductor { dist: Microfacet, eta: Rgb, k: Rgb, specular: Rgb },
+    RoughConductor(RoughConductor),
     /// Smooth glass: `eta` is n_inside / n_outside.
-    Dielectric { eta: f32, reflect: Rgb, transmit: Rgb },
+    Dielectric(Dielectric),
     /// Rough glass with a microfacet interface.
-    RoughDielectric { dist: Microfacet, eta: f32, reflect: Rgb, transmit: Rgb },
+    RoughDielectric(RoughDielectric),
     /// An infinitely thin slab of glass: reflection and straight-through transmission with
     /// the inter-reflections summed (Mitsuba's `thindielectric`).
-    ThinDielectric { eta: f32, reflect: Rgb, transmit: Rgb },
+    ThinDielectric(ThinDielectric),
     /// Diffuse base under a smooth or rough dielectric coating (Mitsuba's `plastic` and
     /// `roughplastic`), with the internal-scattering correction of the diffuse term.
-    Plastic(crate::bsdf::PlasticParams),
+    Plastic(PlasticParams),
     /// Absorbs everything (light sources with no material).
-    Black,
+    Black(Black),
     /// Passes light straight through, unchanged (Mitsuba's `null`): a medium's boundary.
-    Null,
+    Null(Null),
     /// Mitsuba's `principled` (Disney) BSDF.
     Principled(Principled),
     /// Mitsuba's `blendbsdf`: a weighted mixture of two BSDFs.
     Blend(BlendBsdf),
     /// Mitsuba's `pplastic` as its unpolarized variants render it.
     PPlastic(PPlasticParams),
-}
-
-mod plastic;
-mod pplastic;
-pub use plastic::PlasticParams;
-pub use pplastic::PPlasticParams;
-
-impl Bsdf {
-    /// True when every lobe is a delta: light sampling is pointless there.
-    pub fn is_delta(&self) -> bool {
-        match self {
-            Bsdf::Conductor { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } | Bsdf::Null => true,
-            Bsdf::Plastic(p) => p.is_delta_only(),
-            Bsdf::Blend(b) => b.is_delta(),
-            _ => false,
-        }
-    }
-
-    /// True when the BSDF has a delta lobe beside smooth ones (smooth plastic).
-    pub fn has_delta_lobe(&self) -> bool {
-        match self {
-            Bsdf::Plastic(p) => p.dist.is_none(),
-            Bsdf::Blend(b) => b.has_delta_lobe(),
-            _ => self.is_delta(),
-        }
-    }
-
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        match self {
-            Bsdf::Diffuse { reflectance } => {
-                if wo.z <= 0.0 || wi.z <= 0.0 {
-                    return Rgb::BLACK;
-                }
-                *reflectance * (INV_PI * wi.z)
-            }
-            Bsdf::Phong(p) => p.eval(wo, wi),
-            Bsdf::RoughConductor { dist, eta, k, specular } => {
-                if wo.z <= 0.0 || wi.z <= 0.0 {
-                    return Rgb::BLACK;
-                }
-                let h = (wo + wi).normalize();
-                let d = dist.d(h);
-                if d == 0.0 {
-                    return Rgb::BLACK;
-                }
-                let f = fresnel_conductor(wi.dot(h), *eta, *k);
-                let g = dist.g(wo, wi, h);
-                *specular * f * (d * g / (4.0 * wo.z))
-            }
-            Bsdf::RoughDielectric { dist, eta, reflect, transmit } => {
-                microfacet::eval_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
-            }
-            Bsdf::Plastic(p) => p.eval(wo, wi),
-            Bsdf::PPlastic(p) => p.eval(wo, wi),
-            Bsdf::Principled(p) => p.eval(wo, wi),
-            Bsdf::Blend(b) => b.eval(wo, wi),
-            Bsdf::Conductor { .. }
-            | Bsdf::Dielectric { .. }
-            | Bsdf::ThinDielectric { .. }
-            | Bsdf::Black
-            | Bsdf::Null => Rgb::BLACK,
-        }
-    }
-
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self {
-            Bsdf::Diffuse { .. } => {
-                if wo.z <= 0.0 || wi.z <= 0.0 {
-                    0.0
-                } else {
-                    warp::cosine_hemisphere_pdf(wi.z)
-                }
-            }
-            Bsdf::Phong(p) => p.pdf(wo, wi),
-            Bsdf::RoughConductor { dist, .. } => {
-                if wo.z <= 0.0 || wi.z <= 0.0 {
-                    return 0.0;
-                }
-                let h = (wo + wi).normalize();
-                dist.pdf_wm(wo, h) / (4.0 * wo.dot(h))
-            }
-            Bsdf::RoughDielectric { dist, eta, reflect, transmit } => {
-                microfacet::pdf_rough_dielectric(dist, *eta, *reflect, *transmit, wo, wi)
-            }
-            Bsdf::Plastic(p) => p.pdf(wo, wi),
-            Bsdf::Principled(p) => p.pdf(wo, wi),
-            Bsdf::Blend(b) => b.pdf(wo, wi),
-            Bsdf::PPlastic(p) => p.pdf(wo, wi),
-            _ => 0.0,
-        }
-    }
-
-    /// Samples `wi` given `wo`. `u_lobe` chooses among lobes, `u` drives the direction.
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
-        match self {
-            Bsdf::Diffuse { reflectance } => {
-                if wo.z <= 0.0 {
-                    return None;
-                }
-                let wi = warp::cosine_hemisphere(u);
-                if wi.z <= 0.0 {
-                    return None;
-                }
-                Some(BsdfSample {
-                    wi,
-                    weight: *reflectance,
-                    pdf: warp::cosine_hemisphere_pdf(wi.z),
-                    delta: false,
-                    eta: 1.0,
-                })
-            }
-            Bsdf::Phong(p) => p.sample(wo, u_lobe, u),
-            Bsdf::Conductor { eta, k, specular } => {
-                if wo.z <= 0.0 {
-                    return None;
-                }
-                let wi = reflect_local(wo);
-                Some(BsdfSample {
-                    wi,
-                    weight: *specular * fresnel_conductor(wo.z, *eta, *k),
-                    pdf: 1.0,
-                    delta: true,
-                    eta: 1.0,
-                })
-            }
-            Bsdf::RoughConductor { dist, .. } => {
-                if wo.z <= 0.0 {
-                    return None;
-                }
-                let h = dist.sample_wm(wo, u);
-                let wi = (h * (2.0 * wo.dot(h)) - wo).normalize();
-                BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
-            }
-            Bsdf::Dielectric { eta, reflect, transmit } => {
-                let fr = fresnel_dielectric(wo.z, *eta);
-                if u_lobe < fr.reflectance {
-                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true, eta: 1.0 })
-                } else {
-                    let wi = refract_local(wo, &fr);
-                    let scale = 1.0 / (fr.eta_ti * fr.eta_ti);
-                    Some(BsdfSample { wi, weight: *transmit * scale, pdf: 1.0, delta: true, eta: fr.eta_ti })
-                }
-            }
-            Bsdf::ThinDielectric { eta, reflect, transmit } => {
-                let mut r = fresnel_dielectric(wo.z.abs(), *eta).reflectance;
-                // Sum of the geometric series of internal bounces (Mitsuba thindielectric).
-                if r < 1.0 {
-                    r *= 2.0 / (1.0 + r);
-                }
-                if u_lobe < r {
-                    Some(BsdfSample { wi: reflect_local(wo), weight: *reflect, pdf: 1.0, delta: true, eta: 1.0 })
-                } else {
-                    Some(BsdfSample { wi: -wo, weight: *transmit, pdf: 1.0, delta: true, eta: 1.0 })
-                }
-            }
-            Bsdf::RoughDielectric { dist, eta, reflect, transmit } => {
-                microfacet::sample_rough_dielectric(dist, *eta, *reflect, *transmit, wo, u_lobe, u)
-            }
-            Bsdf::Plastic(p) => p.sample(wo, u_lobe, u),
-            Bsdf::PPlastic(p) => p.sample(wo, u_lobe, u),
-            Bsdf::Black => None,
-            Bsdf::Null => Some(BsdfSample { wi: -wo, weight: Rgb::WHITE, pdf: 1.0, delta: true, eta: 1.0 }),
-            Bsdf::Principled(p) => p.sample(wo, u_lobe, u),
-            Bsdf::Blend(b) => b.sample(wo, u_lobe, u),
-        }
-    }
-
-    /// Fraction of light reflected and transmitted (for the Whitted integrator's mix);
-    /// the delta directions themselves come from `sample`.
-    pub fn diffuse_reflectance(&self) -> Rgb {
-        match self {
-            Bsdf::Diffuse { reflectance } => *reflectance,
-            Bsdf::Phong(p) => p.kd,
-            Bsdf::Plastic(p) => p.diffuse,
-            Bsdf::Principled(p) => p.diffuse_reflectance(),
-            Bsdf::Blend(b) => b.diffuse_reflectance(),
-            Bsdf::PPlastic(p) => p.diffuse,
-            _ => Rgb::BLACK,
-        }
-    }
 }

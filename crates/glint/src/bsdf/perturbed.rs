@@ -122,6 +122,7 @@ pub fn flip_invalid(n: Vec3, wo: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::Diffuse;
     use crate::math::vec3;
     use crate::sampling::Rng;
 
@@ -136,7 +137,7 @@ mod tests {
 
     #[test]
     fn a_flat_normal_map_leaves_the_bsdf_unchanged() {
-        let bsdf = Bsdf::Diffuse { reflectance: Rgb::splat(0.7) };
+        let bsdf = Bsdf::Diffuse(Diffuse { reflectance: Rgb::splat(0.7) });
         let mut rng = Rng::new(7, 0);
         for _ in 0..1000 {
             let (wo, wi) = (random_dir(&mut rng), random_dir(&mut rng));

@@ -1,7 +1,7 @@
 //! Diffuse + normalised Phong lobe (Lafortune and Willems 1994): energy-conserving when
 //! kd + ks <= 1, so the same material works in the Whitted and the path tracer.
 
-use super::{reflect_local, BsdfSample};
+use super::{reflect_local, BsdfSample, Scatter};
 use crate::math::{Frame, Rgb, Vec3, INV_PI, PI};
 use crate::sampling::warp;
 
@@ -32,15 +32,25 @@ impl Phong {
             (self.exponent + 2.0) * 0.5 * INV_PI * cos_alpha.powf(self.exponent)
         }
     }
+}
 
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+impl Scatter for Phong {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        false
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::BLACK;
         }
         (self.kd * INV_PI + self.ks * self.lobe(wo, wi)) * wi.z
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -50,7 +60,7 @@ impl Phong {
         ps * spec + (1.0 - ps) * warp::cosine_hemisphere_pdf(wi.z)
     }
 
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -65,5 +75,9 @@ impl Phong {
             warp::cosine_hemisphere(u)
         };
         BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        self.kd
     }
 }

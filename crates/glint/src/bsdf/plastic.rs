@@ -7,7 +7,7 @@
 //! its internal reflectance (Mitsuba's `roughplastic` model), both integrated here with the
 //! rough dielectric BSDF.
 
-use super::{fresnel_dielectric, reflect_local, BsdfSample, Microfacet};
+use super::{fresnel_dielectric, reflect_local, BsdfSample, Microfacet, Scatter};
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
 use std::collections::HashMap;
@@ -125,10 +125,6 @@ impl PlasticParams {
         }
     }
 
-    pub fn is_delta_only(&self) -> bool {
-        false
-    }
-
     fn specular_weight(&self) -> f32 {
         let d = self.diffuse.average();
         let s = self.specular.average();
@@ -163,7 +159,21 @@ impl PlasticParams {
         albedo * (INV_PI * wi.z * to * ti / (self.eta * self.eta))
     }
 
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    fn finish(&self, wo: Vec3, wi: Vec3) -> Option<BsdfSample> {
+        BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
+    }
+}
+
+impl Scatter for PlasticParams {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        self.dist.is_none()
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::BLACK;
         }
@@ -176,7 +186,7 @@ impl PlasticParams {
         v
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -189,7 +199,7 @@ impl PlasticParams {
         p
     }
 
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -225,8 +235,8 @@ impl PlasticParams {
         self.finish(wo, wi)
     }
 
-    fn finish(&self, wo: Vec3, wi: Vec3) -> Option<BsdfSample> {
-        BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
+    fn diffuse_reflectance(&self) -> Rgb {
+        self.diffuse
     }
 }
 

@@ -4,7 +4,7 @@
 //! (unlike `roughplastic`). The lobes are chosen with a fixed probability, the specular
 //! reflectance's share of the two albedos.
 
-use super::{fresnel_dielectric, BsdfSample, Microfacet};
+use super::{fresnel_dielectric, BsdfSample, Microfacet, Scatter};
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
 
@@ -20,8 +20,16 @@ pub struct PPlasticParams {
     pub specular_probability: f32,
 }
 
-impl PPlasticParams {
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+impl Scatter for PPlasticParams {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        false
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::BLACK;
         }
@@ -32,7 +40,7 @@ impl PPlasticParams {
         specular + self.diffuse * ((1.0 - fo) * (1.0 - fi) * INV_PI * wi.z)
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -43,7 +51,7 @@ impl PPlasticParams {
         ps * specular + (1.0 - ps) * warp::cosine_hemisphere_pdf(wi.z)
     }
 
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -54,5 +62,9 @@ impl PPlasticParams {
             warp::cosine_hemisphere(u)
         };
         BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        self.diffuse
     }
 }

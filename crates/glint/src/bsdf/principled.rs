@@ -8,7 +8,7 @@
 //! The main lobe is anisotropic GGX with visible-normal sampling; `microfacet.rs` is
 //! isotropic, so the anisotropic distribution lives here ([`AnisoGgx`]).
 
-use super::{fresnel_dielectric, BsdfSample};
+use super::{fresnel_dielectric, BsdfSample, Scatter};
 use crate::math::{Rgb, Vec3, INV_PI, PI};
 use crate::sampling::warp;
 
@@ -337,7 +337,41 @@ impl Principled {
         f + Rgb::splat((1.0 - self.metallic) * (1.0 - self.spec_tint) * f_dielectric)
     }
 
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    fn diffuse_and_sheen(&self, wo: Vec3, wi: Vec3, wh: Vec3, brdf: f32) -> Rgb {
+        let (ci, co) = (wi.z.abs(), wo.z.abs());
+        let (f_light, f_view) = (schlick_weight(ci), schlick_weight(co));
+        let f_diff = (1.0 - 0.5 * f_view) * (1.0 - 0.5 * f_light);
+        let cos_d = wh.dot(wi);
+        let rr = 2.0 * self.roughness * cos_d * cos_d;
+        let f_retro = rr * (f_light + f_view + f_light * f_view * (rr - 1.0));
+        let mut lobe = f_diff + f_retro;
+        if self.flatness > 0.0 {
+            // Hanrahan-Krueger-like fake subsurface, flattened by roughness.
+            let fss90 = rr / 2.0;
+            let fss = lerp(1.0, fss90, f_light) * lerp(1.0, fss90, f_view);
+            let f_ss = 1.25 * (fss * (1.0 / (ci + co) - 0.5) + 0.5);
+            lobe = lerp(lobe, f_ss, self.flatness);
+        }
+        let mut value = self.base_color * (brdf * ci * INV_PI * lobe);
+        if self.sheen > 0.0 && 1.0 - self.metallic > 0.0 {
+            let fd = schlick_weight(cos_d.abs());
+            let c_sheen = Rgb::WHITE * (1.0 - self.sheen_tint) + tint_of(self.base_color) * self.sheen_tint;
+            value += c_sheen * (self.sheen * (1.0 - self.metallic) * fd * ci);
+        }
+        value
+    }
+}
+
+impl Scatter for Principled {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        false
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         let (cos_o, cos_i) = (wo.z, wi.z);
         if cos_o == 0.0 {
             return Rgb::BLACK;
@@ -375,31 +409,7 @@ impl Principled {
         value
     }
 
-    fn diffuse_and_sheen(&self, wo: Vec3, wi: Vec3, wh: Vec3, brdf: f32) -> Rgb {
-        let (ci, co) = (wi.z.abs(), wo.z.abs());
-        let (f_light, f_view) = (schlick_weight(ci), schlick_weight(co));
-        let f_diff = (1.0 - 0.5 * f_view) * (1.0 - 0.5 * f_light);
-        let cos_d = wh.dot(wi);
-        let rr = 2.0 * self.roughness * cos_d * cos_d;
-        let f_retro = rr * (f_light + f_view + f_light * f_view * (rr - 1.0));
-        let mut lobe = f_diff + f_retro;
-        if self.flatness > 0.0 {
-            // Hanrahan-Krueger-like fake subsurface, flattened by roughness.
-            let fss90 = rr / 2.0;
-            let fss = lerp(1.0, fss90, f_light) * lerp(1.0, fss90, f_view);
-            let f_ss = 1.25 * (fss * (1.0 / (ci + co) - 0.5) + 0.5);
-            lobe = lerp(lobe, f_ss, self.flatness);
-        }
-        let mut value = self.base_color * (brdf * ci * INV_PI * lobe);
-        if self.sheen > 0.0 && 1.0 - self.metallic > 0.0 {
-            let fd = schlick_weight(cos_d.abs());
-            let c_sheen = Rgb::WHITE * (1.0 - self.sheen_tint) + tint_of(self.base_color) * self.sheen_tint;
-            value += c_sheen * (self.sheen * (1.0 - self.metallic) * fd * ci);
-        }
-        value
-    }
-
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (cos_o, cos_i) = (wo.z, wi.z);
         if cos_o == 0.0 {
             return 0.0;
@@ -437,7 +447,7 @@ impl Principled {
         }
     }
 
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
         let cos_o = wo.z;
         if cos_o == 0.0 {
             return None;
@@ -491,7 +501,7 @@ impl Principled {
     }
 
     /// The diffuse colour (for the Whitted integrator and denoiser guides).
-    pub fn diffuse_reflectance(&self) -> Rgb {
+    fn diffuse_reflectance(&self) -> Rgb {
         self.base_color
     }
 }

@@ -25,7 +25,7 @@
 use super::path::MAX_PATH_DEPTH;
 use super::surface::opacity;
 use super::{shading, shadow_ray, spawn_ray, Counters};
-use crate::bsdf::{fresnel_dielectric, Bsdf, BsdfSample};
+use crate::bsdf::{Bsdf, BsdfSample, Null};
 use crate::describe::VolpathSettings;
 use crate::lights::LightSample;
 use crate::math::{offset_origin, Ray, Rgb, Vec3};
@@ -338,14 +338,8 @@ fn next_segment(si: &SurfaceInteraction, ray: &Ray, t: f32) -> Ray {
 /// that are not passages.
 fn passage_transmission(bsdf: &Bsdf, wo: Vec3) -> Option<Rgb> {
     match bsdf {
-        Bsdf::Null => Some(Rgb::WHITE),
-        Bsdf::ThinDielectric { eta, transmit, .. } => {
-            let mut r = fresnel_dielectric(wo.z.abs(), *eta).reflectance;
-            if r < 1.0 {
-                r *= 2.0 / (1.0 + r);
-            }
-            Some(*transmit * (1.0 - r))
-        }
+        Bsdf::Null(Null) => Some(Rgb::WHITE),
+        Bsdf::ThinDielectric(thin) => Some(thin.transmit * (1.0 - thin.reflectance(wo.z))),
         _ => None,
     }
 }
@@ -353,8 +347,8 @@ fn passage_transmission(bsdf: &Bsdf, wo: Vec3) -> Option<Rgb> {
 /// Whether a BSDF sample went straight through a passage (not a scattering event).
 fn is_passage(bsdf: &Bsdf, wo: Vec3, bs: &BsdfSample) -> bool {
     match bsdf {
-        Bsdf::Null => true,
-        Bsdf::ThinDielectric { .. } => bs.delta && bs.wi == -wo,
+        Bsdf::Null(Null) => true,
+        Bsdf::ThinDielectric(_) => bs.delta && bs.wi == -wo,
         _ => false,
     }
 }

@@ -7,7 +7,7 @@
 
 use super::surface::{passes_mask, transmittance};
 use super::{shading, shadow_ray, spawn_ray, Counters};
-use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, Bsdf};
+use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, Bsdf, Dielectric};
 use crate::describe::WhittedSettings;
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
@@ -112,7 +112,7 @@ fn shade(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
     let can_recurse = depth < s.max_depth;
 
     match bsdf.bsdf {
-        Bsdf::Dielectric { eta, reflect, transmit } => {
+        Bsdf::Dielectric(Dielectric { eta, reflect, transmit }) => {
             if can_recurse {
                 let fr = fresnel_dielectric(wo.z, eta);
                 let r_dir = frame.to_world(reflect_local(wo));
@@ -225,7 +225,7 @@ mod tests {
         let can_recurse = depth < s.max_depth;
 
         match bsdf.bsdf {
-            Bsdf::Dielectric { eta, reflect, transmit } => {
+            Bsdf::Dielectric(Dielectric { eta, reflect, transmit }) => {
                 if can_recurse {
                     let fr = fresnel_dielectric(wo.z, eta);
                     let r_dir = frame.to_world(reflect_local(wo));

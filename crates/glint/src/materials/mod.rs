@@ -13,7 +13,10 @@ pub use roughness::RoughnessMap;
 pub use surface::Perturbation;
 pub use texture::{Bitmap, ScalarTexture, Texture, TexturePoint};
 
-use crate::bsdf::{Bsdf, Microfacet, PPlasticParams, Phong, PlasticParams};
+use crate::bsdf::{
+    Black, Bsdf, Conductor, Dielectric, Diffuse, Microfacet, Null, PPlasticParams, Phong, PlasticParams,
+    RoughConductor, RoughDielectric, ThinDielectric,
+};
 use crate::math::Rgb;
 
 #[derive(Clone, Debug)]
@@ -188,22 +191,27 @@ impl MaterialKind {
     #[inline]
     pub fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
         match self {
-            MaterialKind::Diffuse { reflectance } => Bsdf::Diffuse { reflectance: reflectance.eval_at(p) },
+            MaterialKind::Diffuse { reflectance } => Bsdf::Diffuse(Diffuse { reflectance: reflectance.eval_at(p) }),
             MaterialKind::Phong { kd, ks, exponent } => {
                 Bsdf::Phong(Phong { kd: kd.eval_at(p), ks: *ks, exponent: *exponent })
             }
-            MaterialKind::Conductor { eta, k, specular } => Bsdf::Conductor { eta: *eta, k: *k, specular: *specular },
+            MaterialKind::Conductor { eta, k, specular } => {
+                Bsdf::Conductor(Conductor { eta: *eta, k: *k, specular: *specular })
+            }
             MaterialKind::RoughConductor { dist, eta, k, specular } => {
-                Bsdf::RoughConductor { dist: dist.at(p.uv), eta: *eta, k: *k, specular: *specular }
+                Bsdf::RoughConductor(RoughConductor { dist: dist.at(p.uv), eta: *eta, k: *k, specular: *specular })
             }
             MaterialKind::Dielectric { eta, reflect, transmit } => {
-                Bsdf::Dielectric { eta: *eta, reflect: *reflect, transmit: *transmit }
+                Bsdf::Dielectric(Dielectric { eta: *eta, reflect: *reflect, transmit: *transmit })
             }
-            MaterialKind::RoughDielectric { dist, eta, reflect, transmit } => {
-                Bsdf::RoughDielectric { dist: dist.at(p.uv), eta: *eta, reflect: *reflect, transmit: *transmit }
-            }
+            MaterialKind::RoughDielectric { dist, eta, reflect, transmit } => Bsdf::RoughDielectric(RoughDielectric {
+                dist: dist.at(p.uv),
+                eta: *eta,
+                reflect: *reflect,
+                transmit: *transmit,
+            }),
             MaterialKind::ThinDielectric { eta, reflect, transmit } => {
-                Bsdf::ThinDielectric { eta: *eta, reflect: *reflect, transmit: *transmit }
+                Bsdf::ThinDielectric(ThinDielectric { eta: *eta, reflect: *reflect, transmit: *transmit })
             }
             MaterialKind::Plastic { diffuse, params } => {
                 Bsdf::Plastic(PlasticParams { diffuse: diffuse.eval_at(p), ..*params })
@@ -211,8 +219,8 @@ impl MaterialKind {
             MaterialKind::Black
             | MaterialKind::NormalMap { .. }
             | MaterialKind::BumpMap { .. }
-            | MaterialKind::Mask { .. } => Bsdf::Black,
-            MaterialKind::Null => Bsdf::Null,
+            | MaterialKind::Mask { .. } => Bsdf::Black(Black),
+            MaterialKind::Null => Bsdf::Null(Null),
             MaterialKind::Principled(pr) => Bsdf::Principled(pr.bsdf(p.uv)),
             MaterialKind::Blend(b) => b.bsdf(p.uv),
             MaterialKind::PPlastic { diffuse, specular, eta, dist, specular_probability } => {

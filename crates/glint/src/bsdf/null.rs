@@ -1,0 +1,66 @@
+//! The two BSDFs without parameters: [`Black`] absorbs everything (emitters without a
+//! material), [`Null`] passes light straight through unchanged (Mitsuba's `null`: the
+//! boundary of a medium).
+
+use super::{BsdfSample, Scatter};
+use crate::math::{Rgb, Vec3};
+
+/// Absorbs everything.
+#[derive(Clone, Copy, Debug)]
+pub struct Black;
+
+/// Passes light straight through, unchanged.
+#[derive(Clone, Copy, Debug)]
+pub struct Null;
+
+impl Scatter for Black {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        false
+    }
+
+    fn eval(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::BLACK
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+
+    fn sample(&self, _wo: Vec3, _u_lobe: f32, _u: [f32; 2]) -> Option<BsdfSample> {
+        None
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        Rgb::BLACK
+    }
+}
+
+impl Scatter for Null {
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        true
+    }
+
+    fn eval(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::BLACK
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+
+    fn sample(&self, wo: Vec3, _u_lobe: f32, _u: [f32; 2]) -> Option<BsdfSample> {
+        Some(BsdfSample { wi: -wo, weight: Rgb::WHITE, pdf: 1.0, delta: true, eta: 1.0 })
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        Rgb::BLACK
+    }
+}
