@@ -200,6 +200,14 @@ fn run(
         Ok(())
     })?;
     bar.finish();
+    if let (Some(p), false) = (&preview, job.quiet) {
+        let (frames, spent) = p.cost();
+        let share = 100.0 * spent.as_secs_f64() / report.stats.seconds.max(1e-9);
+        eprintln!(
+            "glint: preview: {frames} frames, {:.3} s copying and encoding ({share:.2}% of the render)",
+            spent.as_secs_f64()
+        );
+    }
     if let Some(e) = tev.as_ref().and_then(|t| t.error()) {
         eprintln!("glint: warning: {e}");
     }

@@ -416,6 +416,21 @@ impl Session {
             }
         };
         add(&mut self.stats, &report.stats);
+        if let Some(p) = self.preview.as_ref().filter(|p| p.watchers() == 0) {
+            // A notebook's page opened after the render shows where it ended.
+            let progress = glint::preview::RenderProgress {
+                spp: glint::preview::film_spp(&self.film),
+                target_spp: self.film.spp(),
+                passes_done: self.film.passes_done(),
+                pass_count: self.film.pass_count(),
+                elapsed: report.stats.seconds,
+                mrays_per_second: report.stats.mrays_per_second(),
+                state: if report.stopped_by_viewer { "stopped" } else { "done" },
+                ..Default::default()
+            };
+            let film = &self.film;
+            py.detach(|| p.publish(film, &progress));
+        }
         if let Some(e) = interrupt {
             return Err(e);
         }

@@ -63,6 +63,7 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
     }
     for s in &d.shapes {
         matrix(&s.to_world, "to_world").map_err(|m| Error::at(&s.loc, m))?;
+        axis_scales(&s.to_world, "to_world").map_err(|m| Error::at(&s.loc, m))?;
         if let Some(e) = &s.emission {
             texture(&e.radiance, "emitted radiance").map_err(|m| Error::at(&s.loc, m))?;
         }
@@ -368,6 +369,23 @@ fn matrix(m: &Matrix4, what: &str) -> Result<(), String> {
     } else {
         Err(format!("{what}: the matrix has a NaN or infinite entry (or one beyond f32's range)"))
     }
+}
+
+/// The scale a transform applies along each axis (the length of each column of its linear
+/// part) must keep squared lengths within f32's normal range, where the world is traced:
+/// beyond, a shape's points, normals or areas overflow or vanish and it renders black. A
+/// scale of exactly 0 (a shape flattened on purpose) is left to the build.
+fn axis_scales(m: &Matrix4, what: &str) -> Result<(), String> {
+    let (lo, hi) = ((f32::MIN_POSITIVE as f64).sqrt(), (f32::MAX as f64).sqrt());
+    for c in 0..3 {
+        let len = (0..3).map(|r| m[r][c] * m[r][c]).sum::<f64>().sqrt();
+        if len != 0.0 && !(lo..=hi).contains(&len) {
+            return Err(format!(
+                "{what}: a scale of {len:.3e} along an axis is degenerate (glint traces in f32: scales from {lo:.1e} to {hi:.1e})"
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn uv(scale: &[f32; 2], offset: &[f32; 2]) -> Result<(), String> {

@@ -92,11 +92,18 @@ fn write_png(img: &Image, path: &Path) -> Result<(), String> {
 }
 
 fn write_exr(img: &Image, path: &Path) -> Result<(), String> {
-    exr::prelude::write_rgb_file(path, img.width, img.height, |x, y| {
+    use exr::prelude::{Encoding, LineOrder, SpecificChannels, Vec2, WritableImage};
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let p = img.pixels[y * img.width + x];
         (p.r, p.g, p.b)
-    })
-    .map_err(|e| e.to_string())
+    });
+    // Blocks in increasing order: compressed in parallel, written in one order, so that
+    // identical renders give identical files.
+    let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::default() };
+    exr::prelude::Image::from_encoded_channels((img.width, img.height), encoding, channels)
+        .write()
+        .to_file(path)
+        .map_err(|e| e.to_string())
 }
 
 fn write_pfm(img: &Image, path: &Path) -> Result<(), String> {
@@ -280,6 +287,35 @@ mod tests {
             let path = dir.join(format!("t.{ext}"));
             write_image(&img, &path).unwrap();
             assert_eq!(read_image(&path).unwrap(), img, "{ext}");
+        }
+    }
+
+    #[test]
+    fn identical_images_give_identical_exr_files() {
+        // Many blocks, compressed on several threads: the file must not depend on which
+        // thread finished first (the beauty alone, and with layers).
+        let dir = crate::scratch::ScratchDir::new("exr-bytes");
+        let (w, h) = (300, 200);
+        let mut img = Image::new(w, h);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            let v = ((i * 2654435761) % 1000) as f32 / 7.0;
+            *p = Rgb { r: v, g: v * 0.5 + (i % 13) as f32, b: (i % w) as f32 };
+        }
+        let depth: Vec<f32> = (0..w * h).map(|i| (i % 977) as f32 * 0.25).collect();
+        let r: Vec<f32> = img.pixels.iter().map(|p| p.r).collect();
+        let channels = [
+            crate::io::layers::Channel { name: "R".into(), values: &r },
+            crate::io::layers::Channel { name: "depth.Z".into(), values: &depth },
+        ];
+        let write_both = |k: usize| {
+            let (a, b) = (dir.join(format!("beauty{k}.exr")), dir.join(format!("layers{k}.exr")));
+            write_image(&img, &a).unwrap();
+            crate::io::layers::write_exr_channels(&b, w, h, &channels).unwrap();
+            (std::fs::read(a).unwrap(), std::fs::read(b).unwrap())
+        };
+        let first = write_both(0);
+        for k in 1..8 {
+            assert!(write_both(k) == first, "write {k} differs from the first");
         }
     }
 

@@ -45,7 +45,9 @@ pub fn write_exr_channels(path: &Path, width: usize, height: usize, channels: &[
     }
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> =
         channels.iter().map(|c| AnyChannel::new(c.name.as_str(), FlatSamples::F32(c.values.to_vec()))).collect();
-    let layer =
-        Layer::new((width, height), LayerAttributes::default(), Encoding::FAST_LOSSLESS, AnyChannels::sort(list));
+    // Blocks in increasing order (not as compression threads finish them): identical
+    // renders give identical files.
+    let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
+    let layer = Layer::new((width, height), LayerAttributes::default(), encoding, AnyChannels::sort(list));
     write_atomically(path, |tmp| exr::prelude::Image::from_layer(layer).write().to_file(tmp).map_err(|e| e.to_string()))
 }

@@ -105,6 +105,11 @@ impl Budget {
         s.last = Some(Instant::now());
     }
 
+    /// The time spent on the view since the clock started.
+    pub fn spent(&self) -> Duration {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner()).spent
+    }
+
     /// Starts the clock again (a new render call on the same view).
     pub fn restart(&self) {
         let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());

@@ -148,6 +148,12 @@ impl PreviewServer {
         self.shared.update(|s| s.workers = workers);
     }
 
+    /// Frames copied for pages so far, and the time copying and encoding them took (what the
+    /// render paid: encoding counted as 1/cores, as it runs beside the render's threads).
+    pub fn cost(&self) -> (u64, Duration) {
+        (self.shared.lock().frame, self.shared.budget.spent())
+    }
+
     /// Lets the Stop button be pressed again (a new render on the same page).
     pub fn clear_stop(&self) {
         self.shared.stop.store(false, Ordering::SeqCst);
@@ -183,7 +189,14 @@ impl FilmSink for PreviewServer {
     }
 
     fn finished(&self, film: &Film, progress: &RenderProgress) {
+        // The last frame, for the pages watching (a front end that keeps the page up after
+        // the render, Python's, publishes it itself when none watches).
+        if self.watchers() == 0 {
+            return self.set_progress(progress);
+        }
+        let t = Instant::now();
         self.publish(film, progress);
+        self.shared.budget.spend(t.elapsed());
     }
 
     fn stop_requested(&self) -> bool {

@@ -4,6 +4,7 @@
 use super::RenderProgress;
 use crate::math::srgb_encode;
 use crate::render::{relative_error, Aov, Film};
+use rayon::prelude::*;
 
 /// How a layer's values read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -73,13 +74,13 @@ impl Snapshot {
     /// Copies the film's means (the beauty, every layer it keeps) and per-pixel statistics.
     pub fn of(film: &Film, progress: &RenderProgress) -> Snapshot {
         let (width, height) = (film.width() as usize, film.height() as usize);
-        let beauty = film.image();
+        let (beauty, spp, rel_error) = beauty_and_statistics(film);
         let mut layers = vec![Layer {
             name: "beauty".into(),
             kind: LayerKind::Color,
             channels: 3,
             channel_names: ["R", "G", "B"].map(String::from).to_vec(),
-            data: beauty.pixels.iter().flat_map(|p| [p.r, p.g, p.b]).collect(),
+            data: beauty,
         }];
         for &aov in film.aovs() {
             let Some(img) = film.aov(aov) else { continue };
@@ -95,15 +96,6 @@ impl Snapshot {
                 channel_names: img.channels,
                 data: img.data,
             });
-        }
-        let mut spp = vec![0u32; width * height];
-        let mut rel_error = vec![0f32; width * height];
-        let region = film.region();
-        let rw = region.width() as usize;
-        for (i, s) in film.region_sums().iter().enumerate() {
-            let j = (region.y0 as usize + i / rw) * width + region.x0 as usize + i % rw;
-            spp[j] = s.count.min(u32::MAX as u64) as u32;
-            rel_error[j] = if s.count > 1 { relative_error(s) as f32 } else { f32::INFINITY };
         }
         Snapshot { width, height, layers, spp, rel_error, progress: progress.clone() }
     }
@@ -172,6 +164,36 @@ impl Snapshot {
         });
         Some(v.to_string())
     }
+}
+
+/// The beauty (RGB, as [`Film::image`] gives it), the samples and the relative error of each
+/// pixel, in one parallel pass over the film's sums: the render's threads are idle while this
+/// runs between passes, and its time is what a watched render pays.
+fn beauty_and_statistics(film: &Film) -> (Vec<f32>, Vec<u32>, Vec<f32>) {
+    let (width, height) = (film.width() as usize, film.height() as usize);
+    let mut beauty = vec![0f32; width * height * 3];
+    let mut spp = vec![0u32; width * height];
+    let mut rel_error = vec![f32::INFINITY; width * height];
+    let region = film.region();
+    let (x0, rw) = (region.x0 as usize, region.width() as usize);
+    let sums = film.region_sums();
+    let rows = beauty.par_chunks_mut(width * 3).zip(spp.par_chunks_mut(width)).zip(rel_error.par_chunks_mut(width));
+    rows.enumerate().skip(region.y0 as usize).take(region.height() as usize).for_each(|(y, ((b, n), e))| {
+        let row = &sums[(y - region.y0 as usize) * rw..][..rw];
+        for (i, s) in row.iter().enumerate() {
+            let m = s.mean();
+            b[(x0 + i) * 3..][..3].copy_from_slice(&m.map(|v| v as f32));
+            n[x0 + i] = s.count.min(u32::MAX as u64) as u32;
+            if s.count > 1 {
+                e[x0 + i] = relative_error(s) as f32;
+            }
+        }
+    });
+    if film.splat_rect().is_some() {
+        // A splatting filter's pixel values are weighted means of the splats it received.
+        beauty = film.image().pixels.iter().flat_map(|p| [p.r, p.g, p.b]).collect();
+    }
+    (beauty, spp, rel_error)
 }
 
 fn finite_or_null(v: f32) -> serde_json::Value {
