@@ -47,6 +47,8 @@ __all__ = [
 ]
 
 AOV_NAMES: Tuple[str, ...] = tuple(_glint.AOV_NAMES)
+#: The integrators ``render(integrator=...)`` takes.
+INTEGRATORS: Tuple[str, ...] = tuple(_glint.INTEGRATORS)
 
 
 def _path(value: Any, arg: str) -> str:
@@ -187,6 +189,8 @@ def render(
     threads: Optional[int] = None,
     progress: Optional[Callable[[int, int], Any]] = None,
     preview: Union[bool, str] = False,
+    denoise: bool = False,
+    **overrides: Any,
 ) -> RenderResult:
     """Renders the scene and returns a RenderResult.
 
@@ -197,9 +201,17 @@ def render(
     second and once at the end. Ctrl-C raises KeyboardInterrupt. ``preview``: True (or an
     address, "HOST:PORT") serves a live view of the render in the browser, shown inline in
     Jupyter and its address printed elsewhere (``Session.preview``); its Stop button ends
-    the render after the current pass, and the result holds the passes done.
+    the render after the current pass, and the result holds the passes done. ``denoise``: the
+    image denoised by Open Image Denoise (as ``glint render --denoise``: the albedo and normal
+    layers guide it, and the image as rendered is the layer ``noisy``).
+
+    Keyword overrides of the scene's settings, as the command line's flags (the scene is
+    not changed for later renders): ``integrator`` (one of ``INTEGRATORS``), ``max_depth``
+    (path tracers: segments, -1 unbounded; whitted: recursion depth), ``strategy`` (mis,
+    light, bsdf), ``light_selection`` (uniform, area, power), ``sampler`` (sobol,
+    independent), ``width``, ``height``.
     """
-    s = make_session(scene, spp=spp, seed=seed, aovs=aovs, threads=threads)
+    s = make_session(scene, spp=spp, seed=seed, aovs=aovs, threads=threads, denoise=denoise, **overrides)
     if preview is not False and preview is not None:
         if not isinstance(preview, (bool, str)):
             raise TypeError(f"preview must be True or an address, not {type(preview).__name__}")
@@ -209,7 +221,36 @@ def render(
     if progress is not None and not callable(progress):
         raise TypeError("progress must be callable")
     s.render_passes(None, time_limit, progress)
-    return RenderResult(image=s.image(), aovs=dict(s.aovs()), spp=s.spp, stats=dict(s.stats))
+    image, layers = s.outputs(denoise)
+    return RenderResult(image=image, aovs=dict(layers), spp=s.spp, stats=dict(s.stats))
+
+
+#: Render overrides ``render`` and ``make_session`` take, and the type of each.
+_OVERRIDES = {
+    "integrator": str,
+    "max_depth": int,
+    "strategy": str,
+    "light_selection": str,
+    "sampler": str,
+    "width": int,
+    "height": int,
+}
+
+
+def _check_overrides(overrides: Mapping[str, Any]) -> Dict[str, Any]:
+    checked = {}
+    for name, value in overrides.items():
+        kind = _OVERRIDES.get(name)
+        if kind is None:
+            raise TypeError(f"unexpected keyword argument {name!r}")
+        if value is None:
+            continue
+        if kind is int:
+            value = _check_int(value, name, -(2**63))
+        elif not isinstance(value, str):
+            raise TypeError(f"{name} must be a str, not {type(value).__name__}")
+        checked[name] = value
+    return checked
 
 
 def show_preview(p: Preview) -> None:
@@ -227,16 +268,27 @@ def show_preview(p: Preview) -> None:
 
 
 def make_session(
-    scene: Scene, spp: Optional[int] = None, seed: int = 0, aovs: Sequence[str] = (), threads: Optional[int] = None
+    scene: Scene,
+    spp: Optional[int] = None,
+    seed: int = 0,
+    aovs: Sequence[str] = (),
+    threads: Optional[int] = None,
+    denoise: bool = False,
+    **overrides: Any,
 ) -> Session:
-    """``Session(...)`` with its arguments checked (TypeError naming the argument)."""
+    """``Session(...)`` with its arguments checked (TypeError naming the argument);
+    ``denoise`` and ``overrides`` as ``render`` takes them."""
     _check_scene(scene)
     spp = _check_int(spp, "spp", 1)
     seed = _check_int(seed, "seed", 0)
     threads = _check_int(threads, "threads", 1)
     if isinstance(aovs, str) or not all(isinstance(a, str) for a in aovs):
         raise TypeError("aovs must be a sequence of layer names (str)")
-    return Session(scene, spp, seed, list(aovs), threads)
+    if not isinstance(denoise, bool):
+        raise TypeError(f"denoise must be a bool, not {type(denoise).__name__}")
+    if denoise:
+        _glint.find_denoiser()  # before any sample: a missing one is an ImportError now
+    return Session(scene, spp, seed, list(aovs), threads, None, _check_overrides(overrides), denoise)
 
 
 def read_image(path: Union[str, os.PathLike]) -> np.ndarray:
@@ -244,20 +296,14 @@ def read_image(path: Union[str, os.PathLike]) -> np.ndarray:
     return _glint.read_image(_path(path, "path"))
 
 
-def _layer_channels(name: str, channels: int) -> list:
-    known = {"albedo": "RGB", "variance": "RGB", "normal": "XYZ", "position": "XYZ", "depth": "Z"}
-    suffixes = known.get(name, "RGB" if channels == 3 else "Y" if channels == 1 else None)
-    if suffixes is None or len(suffixes) != channels:
-        suffixes = [str(i) for i in range(channels)]
-    return [f"{name}.{c}" for c in suffixes]
-
-
 def write_image(
     path: Union[str, os.PathLike], image: np.ndarray, aovs: Optional[Mapping[str, np.ndarray]] = None
 ) -> None:
     """Writes a (height, width, 3) linear RGB image as PNG (sRGB, 8 bit), EXR or PFM,
-    chosen by extension. ``aovs`` (name -> (height, width, channels)) are written beside it
-    as EXR layers (``albedo.R``, ``normal.X``, ...): EXR only."""
+    chosen by extension, and ``aovs`` (name -> (height, width, channels)) as the command
+    line writes a render's layers: in an EXR file as channels beside the image
+    (``albedo.R``, ``normal.X``, ...); for PNG and PFM each as its own PNG, ``OUT.NAME.png``,
+    mapped to a visible range."""
     path = _path(path, "path")
     if not isinstance(image, np.ndarray):
         raise TypeError(f"image must be a numpy array, not {type(image).__name__}")
@@ -268,9 +314,7 @@ def write_image(
         a = np.asarray(a, dtype=np.float32)
         if a.ndim == 2:
             a = a[:, :, None]
-        layers.append((_layer_channels(name, a.shape[2]), np.ascontiguousarray(a)))
-    if layers and not path.lower().endswith(".exr"):
-        raise ValueError("aovs can be written to an .exr file only")
+        layers.append((name, np.ascontiguousarray(a)))
     _glint.write_image(path, np.ascontiguousarray(image, dtype=np.float32), layers)
 
 

@@ -12,6 +12,7 @@ _Image = npt.NDArray[np.float32]
 
 DEFAULT_PASS_SPP: int
 AOV_NAMES: Tuple[str, ...]
+INTEGRATORS: Tuple[str, ...]
 
 class SceneError(ValueError):
     message: str
@@ -32,6 +33,7 @@ class Scene:
     def build_counters(self) -> Dict[str, int]: ...
     def build(self) -> None: ...
     def build_inputs(self) -> list[str]: ...
+    def build_files(self) -> list[Tuple[str, Optional[bytes]]]: ...
 
 _Block = Tuple[Tuple[int, int, int, int], Tuple[int, int]]
 
@@ -53,6 +55,8 @@ class Session:
         aovs: Sequence[str] = ...,
         threads: Optional[int] = None,
         region: Optional[Tuple[int, int, int, int]] = None,
+        overrides: Optional[Mapping[str, Union[str, int]]] = None,
+        denoise: bool = False,
     ) -> None: ...
     def render_passes(
         self,
@@ -70,6 +74,12 @@ class Session:
     def aovs(self) -> Dict[str, _Image]: ...
     def aov_channels(self) -> Dict[str, list[str]]: ...
     def preview(self, address: Optional[str] = None) -> Preview: ...
+    def outputs(self, denoise: bool = False) -> Tuple[_Image, Dict[str, _Image]]: ...
+    def check_outputs(self, path: _Path, denoise: bool = False) -> None: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
     @property
     def spp(self) -> int: ...
     @property
@@ -110,10 +120,32 @@ def render(
     threads: Optional[int] = None,
     progress: Optional[Callable[[int, int], Any]] = None,
     preview: Union[bool, str] = False,
+    denoise: bool = False,
+    *,
+    integrator: Optional[str] = None,
+    max_depth: Optional[int] = None,
+    strategy: Optional[str] = None,
+    light_selection: Optional[str] = None,
+    sampler: Optional[str] = None,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
 ) -> RenderResult: ...
 def show_preview(p: Preview) -> None: ...
 def make_session(
-    scene: Scene, spp: Optional[int] = None, seed: int = 0, aovs: Sequence[str] = (), threads: Optional[int] = None
+    scene: Scene,
+    spp: Optional[int] = None,
+    seed: int = 0,
+    aovs: Sequence[str] = (),
+    threads: Optional[int] = None,
+    denoise: bool = False,
+    *,
+    integrator: Optional[str] = None,
+    max_depth: Optional[int] = None,
+    strategy: Optional[str] = None,
+    light_selection: Optional[str] = None,
+    sampler: Optional[str] = None,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
 ) -> Session: ...
 def traverse(scene: Scene) -> SceneParameters: ...
 def read_image(path: _Path) -> _Image: ...

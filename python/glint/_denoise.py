@@ -1,18 +1,11 @@
-"""Denoising with Intel Open Image Denoise (the ``pyoidn`` wheel bundles the library)."""
+"""Denoising with Intel Open Image Denoise: the library's denoiser (the one ``glint render
+--denoise`` uses), which loads the copy the ``pyoidn`` wheel bundles."""
 
 from typing import Any, Optional
 
 import numpy as np
 
-_INSTALL = "glint.denoise needs Intel Open Image Denoise: pip install pyoidn"
-
-
-def _pyoidn() -> Any:
-    try:
-        import pyoidn
-    except ImportError as e:
-        raise ImportError(_INSTALL) from e
-    return pyoidn
+from . import _glint
 
 
 def _image(a: Any, name: str, shape: Optional[tuple] = None) -> np.ndarray:
@@ -25,55 +18,18 @@ def _image(a: Any, name: str, shape: Optional[tuple] = None) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float32)
 
 
-def _run_filter(pyoidn: Any, device: Any, inputs: dict, output: np.ndarray, **options: bool) -> None:
-    flt = pyoidn.Filter(device, pyoidn.OIDN_FILTER_TYPE_RT)
-    try:
-        for name, image in inputs.items():
-            flt.set_image(name, image, pyoidn.OIDN_FORMAT_FLOAT3)
-        flt.set_image(pyoidn.OIDN_IMAGE_OUTPUT, output, pyoidn.OIDN_FORMAT_FLOAT3)
-        for k, v in options.items():
-            flt.set_bool(k, v)
-        flt.set_quality(pyoidn.OIDN_QUALITY_HIGH)
-        flt.commit()
-        flt.execute()
-        err = device.get_error()
-        if err:
-            raise RuntimeError(f"Open Image Denoise: {err}")
-    finally:
-        flt.release()
-
-
 def denoise(image: np.ndarray, albedo: Optional[np.ndarray] = None, normal: Optional[np.ndarray] = None) -> np.ndarray:
     """Denoises a linear HDR image (height, width, 3) with Open Image Denoise.
 
     ``albedo`` and ``normal`` (the ``albedo`` and ``normal`` AOVs of the same render) guide
     it; they are denoised first and the result is then filtered with ``cleanAux``, as
     Blender Cycles' "accurate" prefilter does, so that their own noise is not copied into
-    the image. A normal needs an albedo. Returns a new float32 array.
+    the image. A normal needs an albedo. Returns a new float32 array. Raises ImportError,
+    saying how to install it, where no Open Image Denoise library is found.
     """
-    pyoidn = _pyoidn()
     color = _image(image, "image")
-    aux = {}
     if normal is not None and albedo is None:
         raise ValueError("normal: needs an albedo too")
-    device = pyoidn.Device()
-    try:
-        device.commit()
-        err = device.get_error()
-        if err:
-            raise RuntimeError(f"Open Image Denoise: {err}")
-        if albedo is not None:
-            a = _image(albedo, "albedo", color.shape)
-            clean = np.empty_like(a)
-            _run_filter(pyoidn, device, {pyoidn.OIDN_IMAGE_ALBEDO: a}, clean)
-            aux[pyoidn.OIDN_IMAGE_ALBEDO] = clean
-        if normal is not None:
-            n = _image(normal, "normal", color.shape)
-            clean = np.empty_like(n)
-            _run_filter(pyoidn, device, {pyoidn.OIDN_IMAGE_NORMAL: n}, clean)
-            aux[pyoidn.OIDN_IMAGE_NORMAL] = clean
-        out = np.empty_like(color)
-        _run_filter(pyoidn, device, {pyoidn.OIDN_IMAGE_COLOR: color, **aux}, out, hdr=True, cleanAux=bool(aux))
-    finally:
-        device.release()
-    return out
+    a = None if albedo is None else _image(albedo, "albedo", color.shape)
+    n = None if normal is None else _image(normal, "normal", color.shape)
+    return _glint.denoise(color, a, n)

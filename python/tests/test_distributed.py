@@ -277,14 +277,23 @@ def test_bad_input_fails_on_the_driver_with_the_cli_message(cli, tmp_path, monke
     assert not (tmp_path / "x.png").exists()
 
 
-def test_layers_the_scene_asks_for_need_an_exr_output(tmp_path, monkeypatch):
+def test_every_output_file_is_checked_before_ray(tmp_path, monkeypatch):
     def no_cluster(*args, **kwargs):
         raise AssertionError("Ray was reached before the output was checked")
 
     d = cornell_dict(16)
     d["film"]["aovs"] = ["depth"]
+    scene = glint.load_dict(d, base_dir=SCENES)
     monkeypatch.setattr(ray, "init", no_cluster)
-    with pytest.raises(ValueError, match="exr"):
+    with pytest.raises(glint.SceneError, match="missing.* does not exist"):
+        gd.render(scene, out=str(tmp_path / "missing" / "x.png"))
+    with pytest.raises(ValueError, match="unknown image format"):
+        gd.render(scene, out=str(tmp_path / "x.bmp"))
+    # The depth layer's PNG would overwrite a file the scene reads.
+    mesh = tmp_path / "x.depth.png"
+    mesh.write_bytes((SCENES / "assets" / "cornell-box" / "floor.obj").read_bytes())
+    d["shapes"][0]["file"] = str(mesh)
+    with pytest.raises(glint.SceneError, match="overwrite the scene's input file"):
         gd.render(glint.load_dict(d, base_dir=SCENES), out=str(tmp_path / "x.png"))
     assert not (tmp_path / "x.png").exists()
 

@@ -1,5 +1,6 @@
 //! The command line's arguments and its dispatch to the subcommands.
 
+use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
 use glint::accel::BvhSplit;
 use glint::assemble::BuildOptions;
@@ -8,7 +9,7 @@ use glint::formats::{Define, ReadOptions};
 use glint::lights::LightSelection;
 use glint::render::{Aov, Rect, Schedule};
 use glint::sampling::SamplerKind;
-use glint::session::Session;
+use glint::session::{integrator_names, Overrides, Session};
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -59,7 +60,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub spp: Option<u32>,
     /// Integrator (default: the scene's).
-    #[arg(long, value_parser = ["whitted", "path", "direct", "volpath"])]
+    #[arg(long, value_parser = PossibleValuesParser::new(integrator_names().iter().map(String::as_str)))]
     pub integrator: Option<String>,
     /// Longest path (path: segments, -1 unbounded; whitted: recursion depth).
     #[arg(long, allow_hyphen_values = true)]
@@ -251,6 +252,23 @@ impl From<String> for CliError {
 impl From<&str> for CliError {
     fn from(message: &str) -> CliError {
         CliError::from(message.to_string())
+    }
+}
+
+impl RenderArgs {
+    /// The flags that override the scene's settings.
+    pub fn overrides(&self) -> Overrides {
+        Overrides {
+            integrator: self.integrator.clone(),
+            max_depth: self.max_depth,
+            strategy: self.strategy,
+            light_selection: self.light_selection,
+            sampler: self.sampler,
+            spp: self.spp,
+            seed: self.seed,
+            width: self.width,
+            height: self.height,
+        }
     }
 }
 

@@ -2,11 +2,9 @@
 
 mod bench;
 mod commands;
-mod denoise;
 mod info;
 mod merge;
 mod meshsrc;
-mod outputs;
 mod progress;
 mod rays;
 mod render;

@@ -3,17 +3,15 @@
 //! settings, or overlapping work are refused.
 
 use crate::commands::{CliError, MergeArgs};
-use crate::outputs::{output_files, write_film_image};
-use crate::render::check_output;
-use glint::session::merge_films;
+use glint::session::{check_output, layer_names, merge_films, output_files, Outputs};
 
 pub fn merge_cmd(a: MergeArgs) -> Result<(), CliError> {
     glint::io::image_io::ImageFormat::from_path(&a.output)?;
     let (film, job, hash) = merge_films(&a.films)?;
-    for out in output_files(&a.output, film.aovs()).iter().chain(&a.film_out) {
+    for out in output_files(&a.output, &layer_names(film.aovs(), false)).iter().chain(&a.film_out) {
         check_output(out, &job.desc)?;
     }
-    write_film_image(&film, &a.output, &[])?;
+    Outputs::of_film(&film).write(&a.output)?;
     if let Some(f) = &a.film_out {
         let meta = glint::render::FilmMeta { scene_hash: hash, settings: job.to_json() };
         glint::render::write_film(f, &film, &meta)?;

@@ -4,13 +4,14 @@
 //! and write the image, its layers and the film.
 
 use crate::commands::{CliError, RenderArgs, ResumeArgs, RunArgs};
-use crate::outputs::{output_files, temp_files, write_film_image};
 use crate::progress::ProgressBar;
 use crate::signals;
-use glint::describe::{DirectSettings, IntegratorDesc, PathSettings, SceneDesc, WhittedSettings};
+use glint::denoise::{with_guides, Denoiser};
 use glint::preview::{film_spp, FilmSink, PreviewServer, TevSink};
-use glint::render::{Adaptive, Aov, Film};
-use glint::session::{FilmOptions, RenderControl, RenderReport, Session};
+use glint::render::{Adaptive, Film};
+use glint::session::{
+    check_output, layer_names, output_files, FilmOptions, Outputs, RenderControl, RenderReport, Session,
+};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
@@ -31,27 +32,19 @@ pub fn render_cmd(a: RenderArgs) -> Result<(), CliError> {
     }
     check_run_args(&a.run)?;
     // Found before anything is rendered: a missing denoiser is one line, and no output.
-    let denoiser = if a.denoise { Some(crate::denoise::Oidn::load()?) } else { None };
-    let mut aovs = a.aov.clone();
-    if a.denoise {
-        for needed in [Aov::Albedo, Aov::Normal] {
-            if !aovs.contains(&needed) {
-                aovs.push(needed);
-            }
-        }
-    }
+    let denoiser = if a.denoise { Some(Denoiser::load(None)?) } else { None };
     set_threads(a.threads, a.quiet)?;
     let start = Instant::now();
     let mut session = a.scene.open()?;
-    apply_overrides(session.edit(), &a)?;
-    let aovs = session.film_aovs(&aovs);
+    session.set_overrides(&a.overrides())?;
+    let aovs = session.film_aovs(&with_guides(&a.aov, a.denoise));
     let desc = session.description();
     if let Some(c) = &a.crop {
         if c.x1 > desc.film.width || c.y1 > desc.film.height {
             return Err(format!("--crop {c} is outside the {}x{} image", desc.film.width, desc.film.height).into());
         }
     }
-    for out in output_files(&output, &aovs) {
+    for out in output_files(&output, &layer_names(&aovs, a.denoise)) {
         check_output(&out, desc)?;
     }
     for f in a.run.checkpoint.iter().chain(&a.run.film_out) {
@@ -94,7 +87,7 @@ pub fn resume_cmd(a: ResumeArgs) -> Result<(), CliError> {
         film.set_spp(spp).map_err(|e| CliError::from(format!("--spp {spp}: {e}")))?;
         session.edit().sampler.spp = spp;
     }
-    for out in output_files(&output, film.aovs()) {
+    for out in output_files(&output, &layer_names(film.aovs(), false)) {
         check_output(&out, session.description())?;
     }
     // A resumed render goes on checkpointing into the file it came from.
@@ -114,7 +107,7 @@ struct Job {
     output: PathBuf,
     run: RunArgs,
     quiet: bool,
-    denoiser: Option<crate::denoise::Oidn>,
+    denoiser: Option<Denoiser>,
 }
 
 fn check_run_args(r: &RunArgs) -> Result<(), CliError> {
@@ -150,8 +143,8 @@ fn run(
     if !job.quiet && world.lights().is_empty() {
         eprintln!("glint: warning: {}: the scene has no lights: the image will be black", job.scene_name);
     }
-    for t in temp_files(&job.output, film.aovs()) {
-        signals::register_temp(&t);
+    for t in output_files(&job.output, &layer_names(film.aovs(), job.denoiser.is_some())) {
+        signals::register_temp(&glint::io::layers::temp_path(&t));
     }
     for f in job.run.checkpoint.iter().chain(&job.run.film_out) {
         signals::register_temp(&glint::io::layers::temp_path(f));
@@ -195,7 +188,7 @@ fn run(
             w.attempt(&bar, job.quiet, || glint::render::write_film(ck, film, &meta));
         }
         if let Some(w) = &mut previews {
-            w.attempt(&bar, job.quiet, || write_film_image(film, &job.output, &[]));
+            w.attempt(&bar, job.quiet, || Outputs::of_film(film).write(&job.output));
         }
         Ok(())
     })?;
@@ -266,15 +259,11 @@ fn finish(
     // The preview's Stop button ends the render as Ctrl-C does.
     let interrupted =
         signals::received().filter(|_| report.cancelled).or(report.stopped_by_viewer.then_some(signals::SIGINT));
-    let image = match &job.denoiser {
-        None => write_film_image(film, &job.output, &[]),
-        Some(oidn) => {
-            let noisy = film.image();
-            let layer = |aov: Aov| film.aov(aov).map(|l| layer_image(&l)).ok_or("denoise: a guide layer is missing");
-            let clean = oidn.denoise(&noisy, &layer(Aov::Albedo)?, &layer(Aov::Normal)?)?;
-            crate::outputs::write_image_and_layers(&clean, film, &job.output, &[("noisy".to_string(), noisy)])
-        }
+    let outputs = match &job.denoiser {
+        None => Outputs::of_film(film),
+        Some(denoiser) => Outputs::of_film(film).denoised(denoiser)?,
     };
+    let image = outputs.write(&job.output);
     // The film is written even when the image cannot be (a full disk): it holds the work,
     // and `glint resume` writes the image from it later.
     let checkpoint = job.run.checkpoint.as_ref().map(|ck| glint::render::write_film(ck, film, meta));
@@ -332,15 +321,6 @@ fn finish(
     Ok(())
 }
 
-/// A three-channel layer as an image.
-fn layer_image(l: &glint::render::AovImage) -> glint::io::Image {
-    let mut img = glint::io::Image::new(l.width, l.height);
-    for (p, c) in img.pixels.iter_mut().zip(l.data.chunks_exact(3)) {
-        *p = glint::math::Rgb { r: c[0], g: c[1], b: c[2] };
-    }
-    img
-}
-
 /// More threads than this many times the cores only cost memory and scheduling.
 const THREADS_PER_CORE_LIMIT: usize = 4;
 
@@ -362,125 +342,4 @@ pub fn set_threads(threads: Option<usize>, quiet: bool) -> Result<(), CliError> 
         t
     };
     rayon::ThreadPoolBuilder::new().num_threads(t).build_global().map_err(|e| CliError::from(e.to_string()))
-}
-
-/// The command line's overrides, as edits of the description.
-fn apply_overrides(d: &mut SceneDesc, a: &RenderArgs) -> Result<(), CliError> {
-    if a.width.is_some() || a.height.is_some() {
-        let (w, h) = (a.width.unwrap_or(d.film.width), a.height.unwrap_or(d.film.height));
-        glint::describe::limits::check_resolution(w, h)
-            .map_err(|e| CliError::from(format!("--width/--height: {e}")))?;
-        d.film.width = w;
-        d.film.height = h;
-        // A crop window is in pixels of the scene's resolution: a new one renders it all.
-        d.film.crop = None;
-    }
-    if let Some(spp) = a.spp {
-        if spp == 0 || spp > glint::describe::limits::MAX_SPP {
-            return Err(format!("--spp {spp} is out of range (1 to {})", glint::describe::limits::MAX_SPP).into());
-        }
-        d.sampler.spp = spp;
-    }
-    if let Some(seed) = a.seed {
-        d.sampler.seed = seed;
-    }
-    if let Some(s) = a.sampler {
-        d.sampler.kind = s;
-    }
-    if let Some(sel) = a.light_selection {
-        d.light_selection = sel;
-    }
-    match a.integrator.as_deref() {
-        Some("whitted") if !matches!(d.integrator, IntegratorDesc::Whitted(_)) => {
-            d.integrator = IntegratorDesc::Whitted(WhittedSettings::default())
-        }
-        Some("path") if !matches!(d.integrator, IntegratorDesc::Path(_)) => {
-            d.integrator = IntegratorDesc::Path(PathSettings::default())
-        }
-        Some("direct") if !matches!(d.integrator, IntegratorDesc::Direct(_)) => {
-            d.integrator = IntegratorDesc::Direct(DirectSettings::default())
-        }
-        Some("volpath") if !matches!(d.integrator, IntegratorDesc::Volpath(_)) => {
-            d.integrator = IntegratorDesc::Volpath(glint::describe::VolpathSettings::default())
-        }
-        _ => {}
-    }
-    match &mut d.integrator {
-        IntegratorDesc::Whitted(w) => {
-            if let Some(depth) = a.max_depth {
-                let max = glint::describe::limits::MAX_WHITTED_DEPTH as i64;
-                if !(1..=max).contains(&depth) {
-                    return Err(
-                        format!("--max-depth {depth}: the Whitted integrator needs a depth from 1 to {max}").into()
-                    );
-                }
-                w.max_depth = depth as u32;
-            }
-            if a.strategy.is_some() {
-                return Err("--strategy applies to the path integrator only".into());
-            }
-        }
-        IntegratorDesc::Direct(_) => {
-            if a.max_depth.is_some() {
-                return Err("--max-depth does not apply to the direct integrator (it stops at the first hit)".into());
-            }
-            if a.strategy.is_some() {
-                return Err("--strategy applies to the path integrator only".into());
-            }
-        }
-        IntegratorDesc::Path(p) => {
-            if let Some(depth) = a.max_depth {
-                p.max_depth = unbounded_depth(depth)?;
-            }
-            if let Some(s) = a.strategy {
-                p.strategy = s;
-            }
-        }
-        IntegratorDesc::Volpath(v) => {
-            if let Some(depth) = a.max_depth {
-                v.max_depth = unbounded_depth(depth)?;
-            }
-            if a.strategy.is_some() {
-                return Err("--strategy applies to the path integrator only".into());
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Before any sample is taken: the output's folder exists and is writable, and the output
-/// is not one of the scene's own files.
-pub fn check_output(out: &Path, desc: &SceneDesc) -> Result<(), CliError> {
-    let dir = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(format!("{}: the output folder {} does not exist", out.display(), dir.display()).into());
-    }
-    let probe = dir.join(format!(".glint-write-test-{}", std::process::id()));
-    match std::fs::File::create(&probe) {
-        Ok(_) => {
-            let _ = std::fs::remove_file(&probe);
-        }
-        Err(e) => return Err(format!("{}: cannot write to the folder {}: {e}", out.display(), dir.display()).into()),
-    }
-    let same = |p: &Path| match (std::fs::canonicalize(p), std::fs::canonicalize(&dir)) {
-        (Ok(input), Ok(d)) => out.file_name().is_some_and(|n| d.join(n) == input),
-        _ => false,
-    };
-    if let Some(p) = desc.files().iter().find(|p| same(p)) {
-        return Err(
-            format!("{}: the output would overwrite the scene's input file {}", out.display(), p.display()).into()
-        );
-    }
-    Ok(())
-}
-
-/// `--max-depth` for the path tracers: -1 (any negative) is unbounded.
-fn unbounded_depth(depth: i64) -> Result<Option<u32>, String> {
-    if depth >= u32::MAX as i64 {
-        return Err(format!("--max-depth {depth} is out of range (-1 for unbounded, or 0 to {})", u32::MAX - 1));
-    }
-    Ok(if depth < 0 { None } else { Some(depth as u32) })
 }

@@ -4,6 +4,7 @@
 
 mod convert;
 mod images;
+mod overrides;
 mod preview;
 mod render;
 mod scene;
@@ -18,10 +19,12 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::load_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_json, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_description, m)?)?;
-    m.add_function(wrap_pyfunction!(scene::obj_material_files, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
+    m.add_function(wrap_pyfunction!(images::denoise, m)?)?;
+    m.add_function(wrap_pyfunction!(images::find_denoiser, m)?)?;
     m.add("DEFAULT_PASS_SPP", glint::session::DEFAULT_PASS_SPP)?;
+    m.add("INTEGRATORS", glint::session::integrator_names().to_vec())?;
     m.add("AOV_NAMES", glint::render::Aov::ALL.iter().map(|a| a.name()).collect::<Vec<_>>())?;
     Ok(())
 }

@@ -2,14 +2,19 @@
 //! a time limit, a progress callback and a thread count.
 
 use crate::convert::{guard, panic_message, scene_error};
-use crate::images::image_array;
+use crate::images::{image_array, load_denoiser};
 use crate::preview::Preview;
 use crate::scene::Scene;
+use glint::denoise::with_guides;
 use glint::error::SourceLoc;
+use glint::io::image_io::ImageFormat;
 use glint::preview::{FilmSink, PreviewServer, RenderProgress};
 use glint::render::checkpoint::{decode_film, encode_film};
 use glint::render::{write_film, Aov, Film, FilmMeta, Rect, RenderStats, Silent};
-use glint::session::{read_film_and_job, FilmOptions, RenderControl, RenderJob, RenderReport};
+use glint::session::{
+    check_output, layer_names, output_files, read_film_and_job, FilmOptions, Outputs, Overrides, RenderControl,
+    RenderJob, RenderReport,
+};
 use numpy::ndarray::Array3;
 use numpy::{IntoPyArray, PyArray3};
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
@@ -32,7 +37,8 @@ const PROGRESS_INTERVAL: Duration = Duration::from_millis(250);
 pub struct Session {
     scene: Py<Scene>,
     film: Film,
-    seed: u64,
+    /// Applied to the scene before each use: another session of it may have set others.
+    overrides: Overrides,
     threads: Option<usize>,
     stats: RenderStats,
     /// What checkpoints record beside the sums, for the output named: worked out once, as
@@ -97,9 +103,13 @@ fn add(total: &mut RenderStats, s: &RenderStats) {
 #[pymethods]
 impl Session {
     /// `region` (x0, y0, x1, y1), x1 and y1 exclusive: the pixels this film holds (default
-    /// all), for a render farm's worker.
+    /// all), for a render farm's worker. `overrides`: name -> value of the scene settings
+    /// this session's renders override (integrator, max_depth, strategy, light_selection,
+    /// sampler, width, height). `denoise`: the film keeps the layers that guide the
+    /// denoiser (see `outputs`).
     #[new]
-    #[pyo3(signature = (scene, spp=None, seed=0, aovs=Vec::new(), threads=None, region=None))]
+    #[pyo3(signature = (scene, spp=None, seed=0, aovs=Vec::new(), threads=None, region=None, overrides=None, denoise=false))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         scene: Py<Scene>,
@@ -108,6 +118,8 @@ impl Session {
         aovs: Vec<String>,
         threads: Option<usize>,
         region: Option<(u32, u32, u32, u32)>,
+        overrides: Option<Bound<'_, PyDict>>,
+        denoise: bool,
     ) -> PyResult<Session> {
         guard(|| {
             let aovs = aovs
@@ -117,15 +129,17 @@ impl Session {
             if threads == Some(0) {
                 return Err(PyValueError::new_err("threads: must be at least 1"));
             }
+            let mut overrides = crate::overrides::overrides(spp, Some(seed), overrides.as_ref())?;
             let mut s = scene.borrow_mut(py);
-            s.session.set_sampling(spp, Some(seed)).map_err(|e| scene_error(py, e))?;
+            s.session.set_overrides(&overrides).map_err(|e| PyValueError::new_err(e.message))?;
             let region = region.map(|(x0, y0, x1, y1)| Rect { x0, y0, x1, y1 });
             let film = s
                 .session
-                .new_film(&FilmOptions { pass_spp: None, region, aovs })
+                .new_film(&FilmOptions { pass_spp: None, region, aovs: with_guides(&aovs, denoise) })
                 .map_err(|e| PyValueError::new_err(e.message))?;
             drop(s);
-            Ok(Session { scene, film, seed, threads, stats: RenderStats::default(), meta: None, preview: None })
+            overrides.spp = Some(film.spp());
+            Ok(Session { scene, film, overrides, threads, stats: RenderStats::default(), meta: None, preview: None })
         })
     }
 
@@ -235,6 +249,47 @@ impl Session {
         image_array(py, &self.film.image())
     }
 
+    /// What a render of this film writes: the image and its layers (name -> float32
+    /// (height, width, channels)), the image denoised if asked (the image as rendered is
+    /// then the layer `noisy`, first), as the command line writes them.
+    #[pyo3(signature = (denoise=false))]
+    fn outputs<'py>(
+        &self,
+        py: Python<'py>,
+        denoise: bool,
+    ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyDict>)> {
+        guard(|| {
+            let film = &self.film;
+            let mut outputs = py.detach(|| Outputs::of_film(film));
+            if denoise {
+                let denoiser = load_denoiser(py)?;
+                outputs = py.detach(|| outputs.denoised(&denoiser)).map_err(|e| PyRuntimeError::new_err(e.message))?;
+            }
+            let d = PyDict::new(py);
+            for l in outputs.layers {
+                let arr = Array3::from_shape_vec((l.height, l.width, l.channels.len()), l.data)
+                    .expect("a layer fills the image");
+                d.set_item(l.name, arr.into_pyarray(py))?;
+            }
+            Ok((image_array(py, &outputs.image), d))
+        })
+    }
+
+    /// Checks, before any sample is taken, that the outputs of this film written to `path`
+    /// (the image and, unless it is EXR, a PNG per layer) can be: a known format, an
+    /// existing writable folder, none of them a file of the scene.
+    #[pyo3(signature = (path, denoise=false))]
+    fn check_outputs(&self, py: Python<'_>, path: PathBuf, denoise: bool) -> PyResult<()> {
+        guard(|| {
+            ImageFormat::from_path(&path).map_err(PyValueError::new_err)?;
+            let scene = self.scene.borrow(py);
+            for out in output_files(&path, &layer_names(self.film.aovs(), denoise)) {
+                check_output(&out, scene.session.description()).map_err(|e| scene_error(py, e))?;
+            }
+            Ok(())
+        })
+    }
+
     /// The AOV layers so far: name -> float32 (height, width, channels).
     fn aovs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
@@ -268,6 +323,18 @@ impl Session {
     #[getter]
     fn target_spp(&self) -> u32 {
         self.film.spp()
+    }
+
+    /// Image width in pixels (the scene's, or the override's).
+    #[getter]
+    fn width(&self) -> u32 {
+        self.film.width()
+    }
+
+    /// Image height in pixels.
+    #[getter]
+    fn height(&self) -> u32 {
+        self.film.height()
     }
 
     #[getter]
@@ -309,7 +376,7 @@ impl Session {
             }
         }
         let mut scene = self.scene.try_borrow_mut(py)?;
-        scene.session.set_sampling(Some(self.film.spp()), Some(self.seed)).map_err(|e| scene_error(py, e))?;
+        scene.session.set_overrides(&self.overrides).map_err(|e| scene_error(py, e))?;
         let (session, film) = (&scene.session, &self.film);
         let meta = py.detach(|| session.film_meta(film, output.as_deref())).map_err(|e| scene_error(py, e))?;
         self.meta = Some((output, meta.clone()));
@@ -348,8 +415,8 @@ impl Session {
             None => None,
         };
         let mut scene = self.scene.try_borrow_mut(py)?;
-        // Another session of this scene may have set other sampling.
-        scene.session.set_sampling(Some(self.film.spp()), Some(self.seed)).map_err(|e| scene_error(py, e))?;
+        // Another session of this scene may have set other overrides.
+        scene.session.set_overrides(&self.overrides).map_err(|e| scene_error(py, e))?;
         let session = &mut scene.session;
         let film = &mut self.film;
         if let Some(p) = &self.preview {

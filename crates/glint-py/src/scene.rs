@@ -8,7 +8,7 @@ use glint::session::{Param, ParamValue, Session};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBytes, PyDict, PyList};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
@@ -121,13 +121,6 @@ pub fn load_description(
     })
 }
 
-/// The material files named by the `mtllib` lines of the OBJ file at `path` whose bytes
-/// are `data`: what reading it reads besides it.
-#[pyfunction]
-pub fn obj_material_files(path: PathBuf, data: &[u8]) -> Vec<PathBuf> {
-    glint::io::obj::mtllib_files(data, &path)
-}
-
 fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAny>> {
     Ok(match v {
         ParamValue::Float(x) => (*x as f64).into_pyobject(py)?.into_any(),
@@ -173,6 +166,17 @@ impl Scene {
     /// scene file and its includes are not among them (the description holds them).
     fn build_inputs(&self) -> Vec<PathBuf> {
         self.session.description().build_inputs()
+    }
+
+    /// The files building the world reads with their bytes, each once: the build inputs
+    /// and what reading them reads besides them (an OBJ file's material libraries; bytes
+    /// None for a missing one, which its reader goes on without). What a render farm ships.
+    fn build_files<'py>(&self, py: Python<'py>) -> PyResult<Vec<(PathBuf, Option<Bound<'py, PyBytes>>)>> {
+        guard(|| {
+            let s = &self.session;
+            let files = py.detach(|| s.build_files()).map_err(|e| scene_error(py, e))?;
+            Ok(files.into_iter().map(|f| (f.path, f.bytes.map(|b| PyBytes::new(py, &b)))).collect())
+        })
     }
 
     /// Shapes traced through their transforms since an in-place edit of them.

@@ -8,8 +8,9 @@
 //! - [`integrators`] estimate radiance along rays of a world; [`render`] schedules passes of
 //!   samples over tiles and threads into a film;
 //! - [`session`] ties these together behind one API, which every front end (the `glint`
-//!   command line, Python) uses; [`preview`] holds the live views it feeds as passes land
-//!   (a page in the browser, tev).
+//!   command line, Python, the distributed driver) uses: overrides, outputs and their
+//!   layers, denoising ([`denoise`]) are decided there once for all of them; [`preview`] holds
+//!   the live views it feeds as passes land (a page in the browser, tev).
 //!
 //! Below them: [`math`], [`sampling`], [`accel`] (BVHs over boxes and triangles),
 //! [`geometry`] (shapes), [`bsdf`] and [`materials`], [`media`] (participating media), [`lights`], [`camera`], [`io`] (images
@@ -19,6 +20,7 @@ pub mod accel;
 pub mod assemble;
 pub mod bsdf;
 pub mod camera;
+pub mod denoise;
 pub mod describe;
 pub mod error;
 pub mod formats;

@@ -32,7 +32,6 @@ from ._driver import Driver, Frame, Progress, write_frame
 __all__ = ["Progress", "render"]
 
 _Path = Union[str, os.PathLike]
-_IMAGE_EXTENSIONS = (".png", ".exr", ".pfm")
 
 
 def _ray() -> Any:
@@ -91,19 +90,6 @@ def _per_frame(value: Any, n: int, arg: str) -> List[Optional[str]]:
     return [value.format(frame=i) for i in range(n)]
 
 
-def _check_output(out: str, aovs: Sequence[str]) -> None:
-    """What the command line checks before the first sample: a known format, an existing
-    folder."""
-    ext = os.path.splitext(out)[1].lower()
-    if ext not in _IMAGE_EXTENSIONS:
-        raise ValueError(f"{out}: unknown image format (use .png, .exr or .pfm)")
-    if aovs and ext != ".exr":
-        raise ValueError(f"{out}: AOV layers are written to an .exr output only")
-    folder = os.path.dirname(out) or "."
-    if not os.path.isdir(folder):
-        raise ValueError(f"{out}: the output folder {folder} does not exist")
-
-
 def _check_count(value: Any, arg: str) -> Optional[int]:
     if value is None:
         return None
@@ -140,6 +126,8 @@ def render(
     max_retries: int = 5,
     report: Optional[Callable[[Progress], Any]] = None,
     preview: Union[bool, str] = False,
+    denoise: bool = False,
+    **overrides: Any,
 ) -> Union[RenderResult, List[RenderResult]]:
     """Renders on Ray and returns what ``glint.render`` returns (a list of them for a
     list of scenes, the frames of an animation, which share the workers).
@@ -157,6 +145,9 @@ def render(
     runs a task again whose worker died. ``report(Progress)``: after every block.
     ``preview``: True (or "HOST:PORT") serves the live page of ``glint.render(preview=True)``
     showing the driver's merged film and each worker's tasks; its Stop acts as Ctrl-C.
+    ``denoise``: as ``glint.render`` (on the driver, once the film is whole).
+    ``overrides``: the scene settings ``glint.render`` overrides (``integrator``,
+    ``max_depth``, ``strategy``, ``light_selection``, ``sampler``, ``width``, ``height``).
     """
     frames_in = list(scene) if isinstance(scene, (list, tuple)) else [scene]
     if not frames_in:
@@ -178,17 +169,20 @@ def render(
     frames: List[Frame] = []
     for i, s in enumerate(frames_in):
         sc, name = _load(s)
-        session = make_session(sc, spp=spp, seed=seed, aovs=aovs)
-        sc.build()
+        session = make_session(sc, spp=spp, seed=seed, aovs=aovs, denoise=denoise, **overrides)
+        # What the command line checks before the scene is built, for the image and every
+        # layer file beside it.
         out_i = outs[i]
+        if out_i is not None:
+            session.check_outputs(out_i, denoise)
+        sc.build()
         if resumes[i] is not None:
             recorded = session.load_film(resumes[i])
-            out_i = out_i if out_i is not None else (None if recorded is None else os.fspath(recorded))
-        if out_i is not None:
-            # The film's layers: those asked for and those the scene asks for.
-            _check_output(out_i, list(session.aov_channels()))
+            if out_i is None and recorded is not None:
+                out_i = os.fspath(recorded)
+                session.check_outputs(out_i, denoise)
         ck = checkpoints[i] if checkpoints[i] is not None else resumes[i]
-        frames.append(Frame(sc, name, session, _pack.pack(sc), seed, out_i, ck))
+        frames.append(Frame(sc, name, session, _pack.pack(sc), seed, out_i, ck, denoise))
     load_seconds = time.perf_counter() - started
     live = None
     if preview is not False and preview is not None:
@@ -204,7 +198,7 @@ def render(
 
         ray.init(address=_address(address), include_dashboard=False, logging_level=logging.WARNING)
     try:
-        options = _Options(tile, passes_per_task, cpus_per_task, max_retries, aovs, checkpoint_every, live)
+        options = _Options(tile, passes_per_task, cpus_per_task, max_retries, checkpoint_every, live)
         # Time to load and build the scene on the driver, and to start or reach Ray.
         load = (load_seconds, time.perf_counter() - started - load_seconds)
         results = _run(ray, frames, options, _callback(progress, report), started, load)
@@ -220,7 +214,6 @@ class _Options:
     passes_per_task: Optional[int]
     cpus_per_task: int
     max_retries: int
-    aovs: List[str]
     checkpoint_every: float
     preview: Any = None
 
@@ -251,11 +244,12 @@ def _run(ray: Any, frames: List[Frame], o: _Options, on_block: Any, started: flo
     tasks: List[_plan.Task] = []
     for i, f in enumerate(frames):
         passes = f.session.pass_count
-        tiles = len(_plan.tiles(f.scene.width, f.scene.height, o.tile))
+        width, height = f.session.width, f.session.height
+        tiles = len(_plan.tiles(width, height, o.tile))
         ppt = o.passes_per_task or _plan.auto_passes_per_task(passes, tiles * len(frames), slots)
-        tasks.extend(_plan.plan(i, f.scene.width, f.scene.height, passes, o.tile, ppt, f.session.blocks()))
+        tasks.extend(_plan.plan(i, width, height, passes, o.tile, ppt, f.session.blocks()))
     remote = ray.remote(num_cpus=o.cpus_per_task, max_retries=o.max_retries)(render_block)
-    driver = Driver(frames, tasks, remote, o.cpus_per_task, o.aovs, o.checkpoint_every, on_block, o.preview)
+    driver = Driver(frames, tasks, remote, o.cpus_per_task, o.checkpoint_every, on_block, o.preview)
     already_whole = [f for f in frames if f.tasks_left == 0]
     try:
         totals = driver.run()
@@ -286,6 +280,6 @@ def _run(ray: Any, frames: List[Frame], o: _Options, on_block: Any, started: flo
             merge_seconds=totals.merge_seconds,
             merged_pixels=totals.merged_pixels,
         )
-        s = f.session
-        results.append(RenderResult(image=s.image(), aovs=dict(s.aovs()), spp=s.spp, stats=stats))
+        image, layers = f.outputs()
+        results.append(RenderResult(image=image, aovs=dict(layers), spp=f.session.spp, stats=stats))
     return results

@@ -10,6 +10,7 @@ import time
 import warnings
 from typing import List, Optional
 
+from .. import INTEGRATORS
 from .._errors import SceneError
 from . import Progress, render
 
@@ -22,6 +23,17 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", default="out.png", help="output image (.png, .exr or .pfm)")
     p.add_argument("--spp", type=int, help="samples per pixel (default: the scene's)")
     p.add_argument("--seed", type=int, default=0, help="random seed")
+    p.add_argument("--integrator", choices=INTEGRATORS, help="integrator (default: the scene's)")
+    p.add_argument("--max-depth", type=int, help="longest path (path: segments, -1 unbounded; whitted: recursion depth)")
+    p.add_argument("--strategy", help="path tracer estimator: mis, light or bsdf")
+    p.add_argument("--light-selection", help="light selection for next-event estimation: uniform, area or power")
+    p.add_argument("--sampler", help="sampler: sobol (the default) or independent")
+    p.add_argument("--width", type=int, help="image width (overrides the scene's film)")
+    p.add_argument("--height", type=int, help="image height (overrides the scene's film)")
+    p.add_argument("--aov", action="append", default=[], metavar="NAME[,NAME...]",
+                   help="extra layers: albedo, normal, depth, position, variance, spp, bvh-cost")
+    p.add_argument("--denoise", action="store_true",
+                   help="denoise with Intel Open Image Denoise (EXR output keeps the noisy image as the layer noisy)")
     p.add_argument("--address", help="Ray cluster address (default: start a local Ray instance)")
     p.add_argument("--tile", type=int, default=128, help="tile side in pixels")
     p.add_argument("--passes-per-task", type=int, help="passes per task (default: about 24 tasks per worker)")
@@ -124,6 +136,9 @@ def main(argv: Optional[List[str]] = None) -> int:
             passes_per_task=a.passes_per_task, resume=a.resume, checkpoint=a.checkpoint,
             checkpoint_every=a.checkpoint_every, cpus_per_task=a.cpus_per_task, report=report,
             preview=a.preview,
+            integrator=a.integrator, max_depth=a.max_depth, strategy=a.strategy, light_selection=a.light_selection,
+            sampler=a.sampler, width=a.width, height=a.height, denoise=a.denoise,
+            aovs=[name for names in a.aov for name in names.split(",") if name],
         )
     except KeyboardInterrupt:
         bar.finish()

@@ -39,11 +39,21 @@ class Frame:
     seed: int
     out: Optional[str]
     checkpoint: Optional[str]
+    denoise: bool = False
     pack_ref: Any = None
     tasks_left: int = 0
     dirty: bool = False
     checkpoint_error: Optional[str] = None
     rays: Dict[str, int] = field(default_factory=lambda: dict(RAY_COUNTS))
+    _outputs: Any = None
+
+    def outputs(self) -> Any:
+        """The film's image and layers, as written (denoised if asked, once per state of
+        the film)."""
+        blocks = self.session.blocks()
+        if self._outputs is None or self._outputs[0] != blocks:
+            self._outputs = (blocks, self.session.outputs(self.denoise))
+        return self._outputs[1]
 
 
 @dataclass
@@ -77,7 +87,6 @@ class Driver:
         tasks: List[Task],
         remote: Any,
         cpus_per_task: int,
-        aovs: List[str],
         checkpoint_every: float,
         report: Optional[Callable[[Progress], None]],
         preview: Any = None,
@@ -86,7 +95,6 @@ class Driver:
         self.queue = list(reversed(tasks))  # popped from the end: the plan's order
         self.remote = remote
         self.cpus = cpus_per_task
-        self.aovs = aovs
         self.checkpoint_every = checkpoint_every
         self.report = report
         self.in_flight: Dict[Any, Task] = {}
@@ -118,9 +126,9 @@ class Driver:
             t = self.queue.pop()
             f = self.frames[t.frame]
             s = f.session
-            ref = self.remote.remote(
-                f.pack.key, [f.pack_ref], s.target_spp, f.seed, self.aovs, self.cpus, t.region, t.passes
-            )
+            # The driver's film's layers, so that the workers' blocks merge into it.
+            aovs = list(s.aov_channels())
+            ref = self.remote.remote(f.pack.key, [f.pack_ref], s.target_spp, f.seed, aovs, self.cpus, t.region, t.passes)
             self.in_flight[ref] = t
 
     def run(self) -> Totals:
@@ -236,14 +244,14 @@ def _pixels(t: Task) -> int:
 
 
 def write_frame(f: Frame) -> None:
-    """Writes the frame's image (its AOV layers beside it in an EXR file) and checkpoint."""
+    """Writes the frame's image and its layers (as the command line does) and checkpoint."""
     from .. import write_image
 
     image_error = None
     if f.out:
-        aovs = f.session.aovs()
+        image, layers = f.outputs()
         try:
-            write_image(f.out, f.session.image(), aovs or None)
+            write_image(f.out, image, layers)
         except OSError as e:
             image_error = e
     # The film is written even when the image cannot be (a full disk): it holds the work.

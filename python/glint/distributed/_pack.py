@@ -9,7 +9,6 @@ from dataclasses import dataclass
 from typing import Dict, Tuple
 
 from .. import _glint
-from .._errors import SceneError
 
 
 @dataclass(frozen=True)
@@ -29,26 +28,13 @@ class ScenePack:
         return len(self.description) + sum(len(b) for _, b in self.files.values())
 
 
-def _read(path: str) -> bytes:
-    try:
-        with open(path, "rb") as f:
-            return f.read()
-    except OSError as e:
-        # The driver's build has read it already; this is a file changed under it.
-        raise SceneError(f"{path}: cannot read: {e.strerror}", f"cannot read: {e.strerror}", path) from None
-
-
 def pack(scene: "_glint.Scene") -> ScenePack:
     """Packs a loaded scene (its sampling as the render will use it)."""
-    contents: Dict[str, bytes] = {}
-    queue = [os.fspath(p) for p in scene.build_inputs()]
-    while queue:
-        path = queue.pop(0)
-        if path in contents:
-            continue
-        contents[path] = _read(path)
-        if path.lower().endswith(".obj"):
-            queue.extend(os.fspath(m) for m in _glint.obj_material_files(path, contents[path]))
+    # A side file that is missing (an OBJ file's material library) is left out: the
+    # worker's reader goes on without it, as the driver's does.
+    contents: Dict[str, bytes] = {
+        os.fspath(p): data for p, data in scene.build_files() if data is not None
+    }
     absolute = {p: os.path.abspath(p) for p in contents}
     root = os.path.commonpath([os.path.dirname(a) for a in absolute.values()]) if absolute else ""
     files = {p: (os.path.relpath(absolute[p], root), data) for p, data in contents.items()}

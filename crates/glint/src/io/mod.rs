@@ -14,7 +14,19 @@ pub use image_io::{read_image, write_image, Image};
 pub use texture_file::read_texture_image;
 
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// What reading the file at `path` (whose bytes are `data`) reads besides it, by its
+/// format: the material files an OBJ file's `mtllib` lines name; nothing for the other
+/// files a scene reads (PLY and serialized meshes, images, volume grids), and nothing for
+/// scene files, whose includes their description lists.
+pub fn side_files(path: &Path, data: &[u8]) -> Vec<PathBuf> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "obj" => obj::mtllib_files(data, path),
+        _ => Vec::new(),
+    }
+}
 
 /// Largest mesh or material file glint reads (2 GiB).
 pub const MAX_MESH_FILE_BYTES: u64 = 2 << 30;

@@ -13,9 +13,7 @@
 
 use super::Session;
 use crate::assemble::{patch_appearance, BuildCounters};
-use crate::describe::{
-    limits, Emission, LightKind, MaterialModel, Matrix4, Roughness, ScalarTexture, SceneDesc, TextureDesc,
-};
+use crate::describe::{Emission, LightKind, MaterialModel, Matrix4, Roughness, ScalarTexture, SceneDesc, TextureDesc};
 use crate::error::Error;
 use crate::math::Rgb;
 use std::sync::Arc;
@@ -280,21 +278,6 @@ impl Session {
         if !patched {
             crate::assemble::validate_description(&self.desc)?;
             self.world = None;
-        }
-        Ok(())
-    }
-
-    /// Sets the samples per pixel and seed; the built world is kept (it does not depend on
-    /// them).
-    pub fn set_sampling(&mut self, spp: Option<u32>, seed: Option<u64>) -> Result<(), Error> {
-        if let Some(spp) = spp {
-            if spp == 0 || spp > limits::MAX_SPP {
-                return Err(Error::new(format!("spp {spp} is out of range (1 to {})", limits::MAX_SPP)));
-            }
-            self.desc.sampler.spp = spp;
-        }
-        if let Some(seed) = seed {
-            self.desc.sampler.seed = seed;
         }
         Ok(())
     }

@@ -32,10 +32,16 @@
 //! ```
 
 mod edit;
+mod files;
 mod job;
+mod outputs;
+mod overrides;
 
 pub use edit::{Param, ParamValue};
+pub use files::SceneFile;
 pub use job::{RenderJob, JOB_VERSION};
+pub use outputs::{check_output, layer_channels, layer_names, output_files, Outputs, NOISY_LAYER};
+pub use overrides::{integrator_name, integrator_names, Overrides};
 
 use crate::assemble::{build_cached, BuildOptions, MeshCache, WorldLayout};
 use crate::describe::SceneDesc;
@@ -48,6 +54,8 @@ use crate::render::{
     RenderSettings, RenderStats, Schedule,
 };
 use crate::world::World;
+use files::with_side_files;
+use overrides::OverridableSettings;
 use std::collections::BTreeSet;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -120,6 +128,8 @@ pub struct Session {
     adaptive: Option<Adaptive>,
     /// How paths are scheduled (speed only: the image is the same bits).
     schedule: Schedule,
+    /// The scene's own values of what overrides change, while overrides apply.
+    own_settings: Option<OverridableSettings>,
 }
 
 impl Session {
@@ -138,7 +148,23 @@ impl Session {
             instanced: BTreeSet::new(),
             adaptive: None,
             schedule: Schedule::default(),
+            own_settings: None,
         }
+    }
+
+    /// Applies a front end's overrides to the description for the renders that follow. Each
+    /// call starts from the scene's own settings, so what an earlier call overrode and this
+    /// one does not is the scene's again; overrides that cannot apply change nothing. The
+    /// world is built again only when its camera or light selection changes.
+    pub fn set_overrides(&mut self, overrides: &Overrides) -> Result<(), Error> {
+        let own = self.own_settings.clone().unwrap_or_else(|| OverridableSettings::of(&self.desc));
+        let wanted = overrides.applied_to(&own)?;
+        if wanted.world_differs(&OverridableSettings::of(&self.desc)) {
+            self.world = None;
+        }
+        wanted.store(&mut self.desc);
+        self.own_settings = Some(own);
+        Ok(())
     }
 
     /// How the render schedules paths: one at a time or many in flight. The image is the
@@ -152,9 +178,11 @@ impl Session {
     }
 
     /// The description, to edit; the world is built again on next use (from the cached
-    /// meshes where they are unchanged).
+    /// meshes where they are unchanged). The edited description, overrides included, is
+    /// the scene's own from then on.
     pub fn edit(&mut self) -> &mut SceneDesc {
         self.world = None;
+        self.own_settings = None;
         &mut self.desc
     }
 
@@ -288,26 +316,25 @@ impl Session {
     pub fn scene_hash(&self) -> Result<u64, Error> {
         let mut h = ContentHash::new();
         h.update(serde_json::to_string(&self.desc).expect("a description serialises").as_bytes());
-        for file in self.desc.files() {
-            let bytes =
-                std::fs::read(&file).map_err(|e| Error::at(&SourceLoc::file(&file), format!("cannot read: {e}")))?;
-            h.update(&(bytes.len() as u64).to_le_bytes());
-            h.update(&bytes);
-            // An OBJ's materials come from the files its `mtllib` lines name; a missing one
-            // is hashed as absent (the reader warns and renders without it).
-            if file.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
-                for mtl in crate::io::obj::mtllib_files(&bytes, &file) {
-                    match std::fs::read(&mtl) {
-                        Ok(m) => {
-                            h.update(&(m.len() as u64).to_le_bytes());
-                            h.update(&m);
-                        }
-                        Err(_) => h.update(&u64::MAX.to_le_bytes()),
-                    }
+        // A missing side file is hashed as absent (its reader goes on without it).
+        for file in with_side_files(&self.desc.files())? {
+            match &file.bytes {
+                Some(b) => {
+                    h.update(&(b.len() as u64).to_le_bytes());
+                    h.update(b);
                 }
+                None => h.update(&u64::MAX.to_le_bytes()),
             }
         }
         Ok(h.finish())
+    }
+
+    /// The files building the world reads (meshes and their material libraries, textures,
+    /// environment maps), each once, with their bytes: not the scene file and its
+    /// includes, whose content the description holds. With the description, what a render
+    /// farm ships to its workers.
+    pub fn build_files(&self) -> Result<Vec<SceneFile>, Error> {
+        with_side_files(&self.desc.build_inputs())
     }
 
     /// The job a film of this session records.

@@ -1,22 +1,21 @@
-//! `glint render --denoise`: Intel Open Image Denoise 2, loaded at run time so that glint
-//! builds and runs without it. The library is the one PyPI's `pyoidn` wheel bundles (these
-//! machines have no other): `GLINT_OIDN_LIBRARY` names it, else it is looked for in the
-//! `pyoidn` package of `./.venv` and of `python3`, then on the loader's path.
-//!
-//! As Cycles' "accurate" mode, the albedo and normal layers are denoised first and the image
-//! is then filtered with `cleanAux`, so that the layers' own noise is not copied into it.
+//! Intel Open Image Denoise 2, loaded at run time so that glint builds and runs without it.
+//! The library is the one PyPI's `pyoidn` wheel bundles (these machines have no other):
+//! `GLINT_OIDN_LIBRARY` names it, else it is looked for in the `pyoidn` package of the
+//! Python interpreter a front end names (Python's own), of `./.venv` and of `python3`, then
+//! on the loader's path.
 
-use glint::io::Image;
-use glint::math::Rgb;
+use crate::io::Image;
+use crate::math::Rgb;
 use std::ffi::{c_char, c_void, CStr, CString};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 const DEVICE_TYPE_CPU: i32 = 1;
 const FORMAT_FLOAT3: i32 = 3;
 const ERROR_NONE: i32 = 0;
+const QUALITY_HIGH: i32 = 6;
 const LIBRARY_NAME: &str = "libOpenImageDenoise.so.2";
 const INSTALL_HINT: &str =
-    "--denoise needs Intel Open Image Denoise 2: pip install pyoidn (into ./.venv or python3's site-packages), or set GLINT_OIDN_LIBRARY to libOpenImageDenoise.so.2";
+    "denoising needs Intel Open Image Denoise 2: pip install pyoidn (into ./.venv or python3's site-packages), or set GLINT_OIDN_LIBRARY to libOpenImageDenoise.so.2";
 
 type NewDevice = unsafe extern "C" fn(i32) -> *mut c_void;
 type Handle = unsafe extern "C" fn(*mut c_void);
@@ -24,6 +23,7 @@ type GetError = unsafe extern "C" fn(*mut c_void, *mut *const c_char) -> i32;
 type NewFilter = unsafe extern "C" fn(*mut c_void, *const c_char) -> *mut c_void;
 type SetImage = unsafe extern "C" fn(*mut c_void, *const c_char, *mut c_void, i32, usize, usize, usize, usize, usize);
 type SetBool = unsafe extern "C" fn(*mut c_void, *const c_char, bool);
+type SetInt = unsafe extern "C" fn(*mut c_void, *const c_char, i32);
 
 /// The entry points glint uses, resolved from the loaded library.
 pub struct Oidn {
@@ -34,18 +34,20 @@ pub struct Oidn {
     new_filter: NewFilter,
     set_image: SetImage,
     set_bool: SetBool,
+    set_int: SetInt,
     commit_filter: Handle,
     execute_filter: Handle,
     release_filter: Handle,
 }
 
 /// Where the library may be, most specific first.
-fn candidates() -> Vec<PathBuf> {
+fn candidates(python: Option<&Path>) -> Vec<PathBuf> {
     let mut out = Vec::new();
     if let Some(p) = std::env::var_os("GLINT_OIDN_LIBRARY") {
         return vec![PathBuf::from(p)];
     }
-    for python in [".venv/bin/python", "python3"] {
+    let pythons = python.into_iter().chain([Path::new(".venv/bin/python"), Path::new("python3")]);
+    for python in pythons {
         let probe = std::process::Command::new(python)
             .args(["-c", "import os, pyoidn; print(os.path.dirname(pyoidn.__file__))"])
             .stderr(std::process::Stdio::null())
@@ -61,8 +63,8 @@ fn candidates() -> Vec<PathBuf> {
 
 impl Oidn {
     /// Loads the library, or says in one line how to install it.
-    pub fn load() -> Result<Oidn, String> {
-        for path in candidates() {
+    pub fn load(python: Option<&Path>) -> Result<Oidn, String> {
+        for path in candidates(python) {
             let Ok(c) = CString::new(path.as_os_str().as_encoded_bytes()) else { continue };
             // SAFETY: `c` is a NUL-terminated path; dlopen runs the library's initialisers,
             // which for OIDN only register its devices.
@@ -95,6 +97,7 @@ impl Oidn {
                 new_filter: std::mem::transmute::<*mut c_void, NewFilter>(sym("oidnNewFilter")?),
                 set_image: std::mem::transmute::<*mut c_void, SetImage>(sym("oidnSetSharedFilterImage")?),
                 set_bool: std::mem::transmute::<*mut c_void, SetBool>(sym("oidnSetFilterBool")?),
+                set_int: std::mem::transmute::<*mut c_void, SetInt>(sym("oidnSetFilterInt")?),
                 commit_filter: std::mem::transmute::<*mut c_void, Handle>(sym("oidnCommitFilter")?),
                 execute_filter: std::mem::transmute::<*mut c_void, Handle>(sym("oidnExecuteFilter")?),
                 release_filter: std::mem::transmute::<*mut c_void, Handle>(sym("oidnReleaseFilter")?),
@@ -102,11 +105,12 @@ impl Oidn {
         }
     }
 
-    /// Denoises `color` guided by `albedo` and `normal` (same size; each is prefiltered first).
-    pub fn denoise(&self, color: &Image, albedo: &Image, normal: &Image) -> Result<Image, String> {
+    /// Denoises `color`, guided by `albedo` and `normal` where given (same size; each is
+    /// prefiltered first and the image then filtered with `cleanAux`).
+    pub fn denoise(&self, color: &Image, albedo: Option<&Image>, normal: Option<&Image>) -> Result<Image, String> {
         let (w, h) = (color.width, color.height);
-        if (albedo.width, albedo.height, normal.width, normal.height) != (w, h, w, h) {
-            return Err("denoise: the layers and the image differ in size".into());
+        if albedo.iter().chain(&normal).any(|g| (g.width, g.height) != (w, h)) {
+            return Err("denoise: the guide layers and the image differ in size".into());
         }
         // SAFETY: a null device is checked; the device is released on every path below.
         let device = unsafe { (self.new_device)(DEVICE_TYPE_CPU) };
@@ -117,10 +121,15 @@ impl Oidn {
             // SAFETY: `device` is a live device handle.
             unsafe { (self.commit_device)(device) };
             self.check(device)?;
-            let clean_albedo = self.filter(device, &[("albedo", albedo)], w, h, &[])?;
-            let clean_normal = self.filter(device, &[("normal", normal)], w, h, &[])?;
-            let aux = [("color", color), ("albedo", &clean_albedo), ("normal", &clean_normal)];
-            self.filter(device, &aux, w, h, &[("hdr", true), ("cleanAux", true)])
+            let mut aux = Vec::new();
+            for (name, guide) in [("albedo", albedo), ("normal", normal)] {
+                if let Some(g) = guide {
+                    aux.push((name, self.filter(device, &[(name, g)], w, h, &[])?));
+                }
+            }
+            let mut inputs = vec![("color", color)];
+            inputs.extend(aux.iter().map(|(name, img)| (*name, img)));
+            self.filter(device, &inputs, w, h, &[("hdr", true), ("cleanAux", !aux.is_empty())])
         })();
         // SAFETY: `device` is live and released once.
         unsafe { (self.release_device)(device) };
@@ -165,6 +174,7 @@ impl Oidn {
         }
         let names: Vec<CString> = inputs.iter().map(|(n, _)| CString::new(*n).expect("no NUL")).collect();
         let out_name = CString::new("output").expect("no NUL");
+        let quality = CString::new("quality").expect("no NUL");
         let flag_names: Vec<CString> = flags.iter().map(|(n, _)| CString::new(*n).expect("no NUL")).collect();
         // SAFETY: every buffer holds exactly w*h*3 f32 (packed RGB, so strides of 0), and all
         // outlive the filter, which is released at the end of this block; OIDN only reads the
@@ -188,6 +198,7 @@ impl Oidn {
             for ((_, v), name) in flags.iter().zip(&flag_names) {
                 (self.set_bool)(filter, name.as_ptr(), *v);
             }
+            (self.set_int)(filter, quality.as_ptr(), QUALITY_HIGH);
             (self.commit_filter)(filter);
             (self.execute_filter)(filter);
             (self.release_filter)(filter);
