@@ -410,7 +410,12 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
                 *two_sided = e.two_sided;
             }
             Light::Sphere { radiance, .. } | Light::Cylinder { radiance, .. } => *radiance = e.radiance,
-            _ => unreachable!("an instance's light is an area light"),
+            Light::Point { .. }
+            | Light::Spot { .. }
+            | Light::Directional { .. }
+            | Light::Constant { .. }
+            | Light::EnvMap(_)
+            | Light::Projected(_) => unreachable!("an instance's light is an area light"),
         }
     }
     let first = layout.shape_lights as usize;

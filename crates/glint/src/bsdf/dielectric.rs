@@ -130,4 +130,8 @@ impl Scatter for ThinDielectric {
     fn diffuse_reflectance(&self) -> Rgb {
         Rgb::BLACK
     }
+
+    fn passage_transmission(&self, wo: Vec3) -> Option<Rgb> {
+        Some(self.transmit * (1.0 - self.reflectance(wo.z)))
+    }
 }

@@ -17,7 +17,8 @@
 //! # Adding a BSDF
 //! Write its type in a module of its own with an `impl Scatter` (the compiler names any
 //! method it lacks), and add one line to the `bsdfs!` list below: that line makes the
-//! [`Bsdf`] variant, its dispatch and its `From` conversion.
+//! [`Bsdf`] variant, its dispatch and its `From` conversion. docs/rendering.md ("Adding a
+//! material") lists what else a material touches.
 
 mod blend;
 mod conductor;
@@ -74,7 +75,8 @@ pub struct BsdfSample {
 }
 
 /// What every BSDF answers, in the local shading frame (see the conventions above). No
-/// method has a default, so that a new BSDF states each answer.
+/// method but `passage_transmission` (which only passages answer) has a default, so that a
+/// new BSDF states each answer.
 pub trait Scatter {
     /// True when every lobe is a delta: light sampling is pointless there.
     fn is_delta(&self) -> bool;
@@ -94,6 +96,13 @@ pub trait Scatter {
     /// Fraction of light reflected diffusely (the Whitted integrator's mix and the albedo
     /// guide); the delta directions themselves come from `sample`.
     fn diffuse_reflectance(&self) -> Rgb;
+
+    /// What passes straight through towards `-wo` without scattering (Mitsuba's null
+    /// transmission), for the passages the volumetric path tracer crosses without counting
+    /// a bounce (`null`, a thin dielectric); `None`, the default, for every other surface.
+    fn passage_transmission(&self, _wo: Vec3) -> Option<Rgb> {
+        None
+    }
 }
 
 /// Makes the closed [`Bsdf`] enum from one list of `Variant(Type)`, each type a
@@ -138,6 +147,11 @@ macro_rules! bsdfs {
             /// See [`Scatter::diffuse_reflectance`].
             pub fn diffuse_reflectance(&self) -> Rgb {
                 match self { $(Bsdf::$variant(b) => b.diffuse_reflectance(),)+ }
+            }
+
+            /// See [`Scatter::passage_transmission`].
+            pub fn passage_transmission(&self, wo: Vec3) -> Option<Rgb> {
+                match self { $(Bsdf::$variant(b) => b.passage_transmission(wo),)+ }
             }
         }
 

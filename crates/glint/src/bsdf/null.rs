@@ -63,4 +63,8 @@ impl Scatter for Null {
     fn diffuse_reflectance(&self) -> Rgb {
         Rgb::BLACK
     }
+
+    fn passage_transmission(&self, _wo: Vec3) -> Option<Rgb> {
+        Some(Rgb::WHITE)
+    }
 }

@@ -569,9 +569,15 @@ impl SceneDesc {
         for l in &self.lights {
             match &l.light {
                 LightKind::EnvMap { file, .. } => add(file),
-                LightKind::TexturedSpot { texture: TextureDesc::Bitmap { file, .. }, .. }
-                | LightKind::Projector { irradiance: TextureDesc::Bitmap { file, .. }, .. } => add(file),
-                _ => {}
+                LightKind::TexturedSpot { texture, .. } | LightKind::Projector { irradiance: texture, .. } => {
+                    if let TextureDesc::Bitmap { file, .. } = texture {
+                        add(file);
+                    }
+                }
+                LightKind::Point { .. }
+                | LightKind::Spot { .. }
+                | LightKind::Directional { .. }
+                | LightKind::Constant { .. } => {}
             }
         }
         for m in &self.media {
@@ -614,10 +620,16 @@ impl SceneDesc {
         }
         for l in &mut self.lights {
             match &mut l.light {
-                LightKind::EnvMap { file, .. }
-                | LightKind::TexturedSpot { texture: TextureDesc::Bitmap { file, .. }, .. }
-                | LightKind::Projector { irradiance: TextureDesc::Bitmap { file, .. }, .. } => map(file)?,
-                _ => {}
+                LightKind::EnvMap { file, .. } => map(file)?,
+                LightKind::TexturedSpot { texture, .. } | LightKind::Projector { irradiance: texture, .. } => {
+                    if let TextureDesc::Bitmap { file, .. } = texture {
+                        map(file)?;
+                    }
+                }
+                LightKind::Point { .. }
+                | LightKind::Spot { .. }
+                | LightKind::Directional { .. }
+                | LightKind::Constant { .. } => {}
             }
         }
         for m in &mut self.media {

@@ -752,7 +752,53 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         ));
     }
 
-    let cam = &file.camera;
+    let camera = camera_of(&ctx, &file.camera)?;
+    let film = film_of(&ctx, &file.film)?;
+    let mut desc = SceneDesc::empty(camera, film);
+    desc.source = Some(path.to_path_buf());
+
+    desc.integrator = integrator_of(&ctx, file.integrator.as_ref(), &mut desc.light_selection)?;
+    for (name, m) in &file.media {
+        desc.media.push(medium_of(&ctx, name, m)?);
+    }
+    let medium_ref = |name: &Option<String>, at: &str| -> Result<Option<usize>, Error> {
+        match name {
+            None => Ok(None),
+            Some(n) => match file.media.keys().position(|k| k == n) {
+                Some(i) => Ok(Some(i)),
+                None => Err(ctx.err(at, format!("unknown medium '{n}'"))),
+            },
+        }
+    };
+    desc.camera.medium = medium_ref(&file.camera.medium, "camera/medium")?;
+    desc.sampler = sampler_of(&ctx, &file.sampler)?;
+
+    for (name, m) in &file.materials {
+        desc.materials.push(material_of(&ctx, name, m)?);
+    }
+    for (name, m) in &file.meshes {
+        desc.meshes.push(MeshFileDesc {
+            name: name.clone(),
+            file: ctx.resolve(&m.file),
+            face_normals: m.face_normals,
+            loc: ctx.loc(&format!("meshes/{name}")),
+            shape_index: 0,
+        });
+    }
+
+    for (i, s) in file.shapes.iter().enumerate() {
+        let shape = shape_of(&ctx, &desc, i, s, &medium_ref)?;
+        desc.shapes.push(shape);
+    }
+
+    for (i, l) in file.lights.iter().enumerate() {
+        let at = format!("lights/{i}");
+        desc.lights.push(LightDesc { light: light_of(&ctx, &at, l)?, loc: ctx.loc(&at) });
+    }
+    Ok(desc)
+}
+
+fn camera_of(ctx: &Ctx, cam: &JsonCamera) -> Result<CameraDesc, Error> {
     let to_world =
         Transform::look_at(Vec3::from_array(cam.position), Vec3::from_array(cam.look_at), Vec3::from_array(cam.up))
             .ok_or_else(|| {
@@ -785,7 +831,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         }
         _ => to_world,
     };
-    let camera = CameraDesc {
+    Ok(CameraDesc {
         to_world: Some(to_world.m.0),
         fov_degrees: cam.fov,
         fov_axis,
@@ -796,35 +842,44 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         loc: ctx.loc("camera"),
         medium: None,
         projection,
-    };
-    let filter = match file.film.filter.as_deref() {
+    })
+}
+
+fn film_of(ctx: &Ctx, f: &JsonFilm) -> Result<FilmDesc, Error> {
+    let filter = match f.filter.as_deref() {
         None | Some("box") => PixelFilter::Box,
         Some("tent") => PixelFilter::Tent { radius: 1.0 },
         Some("gaussian") => PixelFilter::Gaussian { stddev: 0.5 },
         Some(other) => return Err(ctx.err("film/filter", format!("unknown filter '{other}' (box, tent, gaussian)"))),
     };
-    let (width, height) = (file.film.width.min(u32::MAX as u64) as u32, file.film.height.min(u32::MAX as u64) as u32);
+    let (width, height) = (f.width.min(u32::MAX as u64) as u32, f.height.min(u32::MAX as u64) as u32);
     crate::describe::limits::check_resolution(width, height).map_err(|e| ctx.err("film", e))?;
-    let film = FilmDesc {
+    Ok(FilmDesc {
         width,
         height,
         filter,
         loc: ctx.loc("film"),
-        crop: file.film.crop.map(|[x, y, w, h]| {
+        crop: f.crop.map(|[x, y, w, h]| {
             let n = |v: u64| v.min(u32::MAX as u64) as u32;
             CropWindow { offset_x: n(x), offset_y: n(y), width: n(w), height: n(h) }
         }),
-        aovs: file.film.aovs.clone(),
-    };
-    let mut desc = SceneDesc::empty(camera, film);
-    desc.source = Some(path.to_path_buf());
+        aovs: f.aovs.clone(),
+    })
+}
 
-    desc.integrator = match &file.integrator {
+/// The integrator, and into `selection` the light selection it names (which the
+/// description keeps beside it).
+fn integrator_of(
+    ctx: &Ctx,
+    integrator: Option<&JsonIntegrator>,
+    selection: &mut LightSelection,
+) -> Result<IntegratorDesc, Error> {
+    Ok(match integrator {
         None => IntegratorDesc::Path(PathSettings::default()),
         Some(JsonIntegrator::Whitted { max_depth, background }) => IntegratorDesc::Whitted(WhittedSettings {
             max_depth: match max_depth {
                 Some(d) => narrow(
-                    &ctx,
+                    ctx,
                     "integrator/max_depth",
                     "max_depth",
                     *d,
@@ -844,18 +899,17 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             hide_emitters,
         }) => {
             if let Some(ls) = light_selection {
-                desc.light_selection =
-                    ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
+                *selection = ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
             }
             let max_depth = match max_depth {
                 Some(d) if *d < 0 => None,
-                Some(d) => Some(narrow(&ctx, "integrator/max_depth", "max_depth", *d as u64, 0, u32::MAX as u64 - 1)?),
+                Some(d) => Some(narrow(ctx, "integrator/max_depth", "max_depth", *d as u64, 0, u32::MAX as u64 - 1)?),
                 None => None,
             };
             IntegratorDesc::Path(PathSettings {
                 max_depth,
                 rr_depth: match rr_depth {
-                    Some(d) => narrow(&ctx, "integrator/rr_depth", "rr_depth", *d, 1, u32::MAX as u64 - 1)?,
+                    Some(d) => narrow(ctx, "integrator/rr_depth", "rr_depth", *d, 1, u32::MAX as u64 - 1)?,
                     None => 5,
                 },
                 rr_probability: *rr_probability,
@@ -865,13 +919,12 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         }
         Some(JsonIntegrator::Direct { emitter_samples, bsdf_samples, light_selection, hide_emitters }) => {
             if let Some(ls) = light_selection {
-                desc.light_selection =
-                    ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
+                *selection = ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
             }
             let max = crate::describe::limits::MAX_DIRECT_SAMPLES as u64;
             let count = |v: &Option<u64>, name: &str| -> Result<u32, Error> {
                 match v {
-                    Some(n) => narrow(&ctx, &format!("integrator/{name}"), name, *n, 0, max),
+                    Some(n) => narrow(ctx, &format!("integrator/{name}"), name, *n, 0, max),
                     None => Ok(1),
                 }
             };
@@ -883,176 +936,151 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         }
         Some(JsonIntegrator::Volpath { max_depth, rr_depth, light_selection, hide_emitters }) => {
             if let Some(ls) = light_selection {
-                desc.light_selection =
-                    ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
+                *selection = ls.parse::<LightSelection>().map_err(|e| ctx.err("integrator/light_selection", e))?;
             }
             IntegratorDesc::Volpath(VolpathSettings {
                 max_depth: match max_depth {
                     Some(d) if *d < 0 => None,
                     Some(d) => {
-                        Some(narrow(&ctx, "integrator/max_depth", "max_depth", *d as u64, 0, u32::MAX as u64 - 1)?)
+                        Some(narrow(ctx, "integrator/max_depth", "max_depth", *d as u64, 0, u32::MAX as u64 - 1)?)
                     }
                     None => None,
                 },
                 rr_depth: match rr_depth {
-                    Some(d) => narrow(&ctx, "integrator/rr_depth", "rr_depth", *d, 1, u32::MAX as u64 - 1)?,
+                    Some(d) => narrow(ctx, "integrator/rr_depth", "rr_depth", *d, 1, u32::MAX as u64 - 1)?,
                     None => 5,
                 },
                 hide_emitters: *hide_emitters,
             })
         }
-    };
-    for (name, m) in &file.media {
-        desc.media.push(medium_of(&ctx, name, m)?);
-    }
-    let medium_ref = |name: &Option<String>, at: &str| -> Result<Option<usize>, Error> {
-        match name {
-            None => Ok(None),
-            Some(n) => match file.media.keys().position(|k| k == n) {
-                Some(i) => Ok(Some(i)),
-                None => Err(ctx.err(at, format!("unknown medium '{n}'"))),
-            },
-        }
-    };
-    desc.camera.medium = medium_ref(&file.camera.medium, "camera/medium")?;
-    desc.sampler = SamplerDesc {
-        kind: match file.sampler.kind.as_deref() {
+    })
+}
+
+fn sampler_of(ctx: &Ctx, s: &JsonSampler) -> Result<SamplerDesc, Error> {
+    Ok(SamplerDesc {
+        kind: match s.kind.as_deref() {
             None => SamplerKind::default(),
             Some(k) => k.parse().map_err(|e: String| ctx.err("sampler/type", e))?,
         },
-        spp: match file.sampler.spp {
-            Some(n) => narrow(&ctx, "sampler/spp", "spp", n, 1, crate::describe::limits::MAX_SPP as u64)?,
+        spp: match s.spp {
+            Some(n) => narrow(ctx, "sampler/spp", "spp", n, 1, crate::describe::limits::MAX_SPP as u64)?,
             None => 16,
         },
-        seed: file.sampler.seed.unwrap_or(0),
+        seed: s.seed.unwrap_or(0),
+    })
+}
+
+/// Resolves a medium's name (at a path in the document) to its index.
+type MediumRef<'a> = dyn Fn(&Option<String>, &str) -> Result<Option<usize>, Error> + 'a;
+
+fn shape_of(ctx: &Ctx, desc: &SceneDesc, i: usize, s: &JsonShape, medium_ref: &MediumRef) -> Result<ShapeDesc, Error> {
+    let at = format!("shapes/{i}");
+    let here = |msg: String| ctx.err(&at, format!("shape {i} ({}): {msg}", s.kind));
+    let to_world = transform_of(&s.transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?;
+    let emission = s
+        .emission
+        .as_ref()
+        .map(|e| Emission { radiance: texture_of(ctx, &format!("{at}/emission"), e), two_sided: s.two_sided_emission });
+    let material = match &s.material {
+        Some(name) => MaterialRef::Index(
+            desc.material_index(name)
+                .ok_or_else(|| ctx.err(&format!("{at}/material"), format!("shape {i}: unknown material '{name}'")))?,
+        ),
+        None if emission.is_some() => MaterialRef::Black,
+        None => MaterialRef::DefaultDiffuse,
     };
+    let geometry = match s.kind.as_str() {
+        "obj" | "ply" => {
+            let file = s.file.as_ref().ok_or_else(|| here("needs 'file'".into()))?;
+            Geometry::MeshFile { file: ctx.resolve(file), face_normals: s.face_normals, shape_index: 0 }
+        }
+        "instance" => {
+            let name = s.mesh.as_ref().ok_or_else(|| here("needs 'mesh'".into()))?;
+            let mesh = desc
+                .meshes
+                .iter()
+                .position(|m| &m.name == name)
+                .ok_or_else(|| ctx.err(&format!("{at}/mesh"), format!("unknown mesh '{name}'")))?;
+            Geometry::Instance { mesh }
+        }
+        "sphere" => {
+            Geometry::Sphere { center: Vec3::from_array(s.center.unwrap_or([0.0; 3])), radius: s.radius.unwrap_or(1.0) }
+        }
+        "rectangle" => Geometry::Rectangle,
+        "cube" => Geometry::Cube,
+        "disk" => Geometry::Disk,
+        "cylinder" => Geometry::Cylinder {
+            p0: Vec3::from_array(s.p0.unwrap_or([0.0; 3])),
+            p1: Vec3::from_array(s.p1.unwrap_or([0.0, 0.0, 1.0])),
+            radius: s.radius.unwrap_or(1.0),
+        },
+        other => {
+            return Err(ctx.err(
+                &format!("{at}/type"),
+                format!(
+                "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk, cylinder)"
+            ),
+            ))
+        }
+    };
+    let use_mtl = s.material.is_none() && matches!(geometry, Geometry::MeshFile { .. } | Geometry::Instance { .. });
+    Ok(ShapeDesc {
+        geometry,
+        to_world,
+        material,
+        use_mtl,
+        emission,
+        flip_normals: s.flip_normals,
+        loc: ctx.loc(&at),
+        media: ShapeMedia {
+            interior: medium_ref(&s.interior, &format!("{at}/interior"))?,
+            exterior: medium_ref(&s.exterior, &format!("{at}/exterior"))?,
+        },
+    })
+}
 
-    for (name, m) in &file.materials {
-        desc.materials.push(material_of(&ctx, name, m)?);
-    }
-    for (name, m) in &file.meshes {
-        desc.meshes.push(MeshFileDesc {
-            name: name.clone(),
-            file: ctx.resolve(&m.file),
-            face_normals: m.face_normals,
-            loc: ctx.loc(&format!("meshes/{name}")),
-            shape_index: 0,
-        });
-    }
-
-    for (i, s) in file.shapes.iter().enumerate() {
-        let at = format!("shapes/{i}");
-        let here = |msg: String| ctx.err(&at, format!("shape {i} ({}): {msg}", s.kind));
-        let to_world = transform_of(&s.transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?;
-        let emission = s.emission.as_ref().map(|e| Emission {
-            radiance: texture_of(&ctx, &format!("{at}/emission"), e),
-            two_sided: s.two_sided_emission,
-        });
-        let material =
-            match &s.material {
-                Some(name) => MaterialRef::Index(desc.material_index(name).ok_or_else(|| {
-                    ctx.err(&format!("{at}/material"), format!("shape {i}: unknown material '{name}'"))
-                })?),
-                None if emission.is_some() => MaterialRef::Black,
-                None => MaterialRef::DefaultDiffuse,
-            };
-        let geometry = match s.kind.as_str() {
-            "obj" | "ply" => {
-                let file = s.file.as_ref().ok_or_else(|| here("needs 'file'".into()))?;
-                Geometry::MeshFile { file: ctx.resolve(file), face_normals: s.face_normals, shape_index: 0 }
+fn light_of(ctx: &Ctx, at: &str, l: &JsonLight) -> Result<LightKind, Error> {
+    Ok(match l {
+        JsonLight::Point { position, intensity } => {
+            LightKind::Point { position: Vec3::from_array(*position), intensity: intensity.rgb() }
+        }
+        JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, texture: Some(t), up } => {
+            let cutoff = cutoff_angle.unwrap_or(20.0);
+            LightKind::TexturedSpot {
+                to_world: json_look_at(ctx, at, position, target, up)?,
+                intensity: intensity.rgb(),
+                cutoff_degrees: cutoff,
+                beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
+                texture: texture_of(ctx, &format!("{at}/texture"), t),
             }
-            "instance" => {
-                let name = s.mesh.as_ref().ok_or_else(|| here("needs 'mesh'".into()))?;
-                let mesh = desc
-                    .meshes
-                    .iter()
-                    .position(|m| &m.name == name)
-                    .ok_or_else(|| ctx.err(&format!("{at}/mesh"), format!("unknown mesh '{name}'")))?;
-                Geometry::Instance { mesh }
+        }
+        JsonLight::Projector { position, target, up, fov, irradiance, scale } => LightKind::Projector {
+            to_world: json_look_at(ctx, at, position, target, up)?,
+            irradiance: texture_of(ctx, &format!("{at}/irradiance"), irradiance),
+            scale: scale.unwrap_or(1.0),
+            fov_degrees: *fov,
+            fov_axis: FovAxis::X,
+        },
+        JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, .. } => {
+            let cutoff = cutoff_angle.unwrap_or(20.0);
+            LightKind::Spot {
+                position: Vec3::from_array(*position),
+                direction: Vec3::from_array(*target) - Vec3::from_array(*position),
+                intensity: intensity.rgb(),
+                cutoff_degrees: cutoff,
+                beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
             }
-            "sphere" => Geometry::Sphere {
-                center: Vec3::from_array(s.center.unwrap_or([0.0; 3])),
-                radius: s.radius.unwrap_or(1.0),
-            },
-            "rectangle" => Geometry::Rectangle,
-            "cube" => Geometry::Cube,
-            "disk" => Geometry::Disk,
-            "cylinder" => Geometry::Cylinder {
-                p0: Vec3::from_array(s.p0.unwrap_or([0.0; 3])),
-                p1: Vec3::from_array(s.p1.unwrap_or([0.0, 0.0, 1.0])),
-                radius: s.radius.unwrap_or(1.0),
-            },
-            other => {
-                return Err(ctx.err(
-                    &format!("{at}/type"),
-                    format!(
-                        "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk, cylinder)"
-                    ),
-                ))
-            }
-        };
-        let use_mtl = s.material.is_none() && matches!(geometry, Geometry::MeshFile { .. } | Geometry::Instance { .. });
-        desc.shapes.push(ShapeDesc {
-            geometry,
-            to_world,
-            material,
-            use_mtl,
-            emission,
-            flip_normals: s.flip_normals,
-            loc: ctx.loc(&at),
-            media: ShapeMedia {
-                interior: medium_ref(&s.interior, &format!("{at}/interior"))?,
-                exterior: medium_ref(&s.exterior, &format!("{at}/exterior"))?,
-            },
-        });
-    }
-
-    for (i, l) in file.lights.iter().enumerate() {
-        let at = format!("lights/{i}");
-        let light = match l {
-            JsonLight::Point { position, intensity } => {
-                LightKind::Point { position: Vec3::from_array(*position), intensity: intensity.rgb() }
-            }
-            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, texture: Some(t), up } => {
-                let cutoff = cutoff_angle.unwrap_or(20.0);
-                LightKind::TexturedSpot {
-                    to_world: json_look_at(&ctx, &at, position, target, up)?,
-                    intensity: intensity.rgb(),
-                    cutoff_degrees: cutoff,
-                    beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
-                    texture: texture_of(&ctx, &format!("{at}/texture"), t),
-                }
-            }
-            JsonLight::Projector { position, target, up, fov, irradiance, scale } => LightKind::Projector {
-                to_world: json_look_at(&ctx, &at, position, target, up)?,
-                irradiance: texture_of(&ctx, &format!("{at}/irradiance"), irradiance),
-                scale: scale.unwrap_or(1.0),
-                fov_degrees: *fov,
-                fov_axis: FovAxis::X,
-            },
-            JsonLight::Spot { position, target, intensity, cutoff_angle, beam_width, .. } => {
-                let cutoff = cutoff_angle.unwrap_or(20.0);
-                LightKind::Spot {
-                    position: Vec3::from_array(*position),
-                    direction: Vec3::from_array(*target) - Vec3::from_array(*position),
-                    intensity: intensity.rgb(),
-                    cutoff_degrees: cutoff,
-                    beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
-                }
-            }
-            JsonLight::Directional { direction, irradiance } => {
-                LightKind::Directional { direction: Vec3::from_array(*direction), irradiance: irradiance.rgb() }
-            }
-            JsonLight::Constant { radiance } => LightKind::Constant { radiance: radiance.rgb() },
-            JsonLight::Envmap { file, scale, transform } => LightKind::EnvMap {
-                file: ctx.resolve(file),
-                scale: scale.unwrap_or(1.0),
-                to_world: transform_of(transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?,
-            },
-        };
-        desc.lights.push(LightDesc { light, loc: ctx.loc(&at) });
-    }
-    Ok(desc)
+        }
+        JsonLight::Directional { direction, irradiance } => {
+            LightKind::Directional { direction: Vec3::from_array(*direction), irradiance: irradiance.rgb() }
+        }
+        JsonLight::Constant { radiance } => LightKind::Constant { radiance: radiance.rgb() },
+        JsonLight::Envmap { file, scale, transform } => LightKind::EnvMap {
+            file: ctx.resolve(file),
+            scale: scale.unwrap_or(1.0),
+            to_world: transform_of(transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?,
+        },
+    })
 }
 
 fn medium_of(ctx: &Ctx, name: &str, m: &JsonMedium) -> Result<MediumDesc, Error> {

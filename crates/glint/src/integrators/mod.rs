@@ -4,6 +4,7 @@
 //! threads lives in the render module, so integrators never see threads.
 
 mod direct;
+mod estimators;
 mod first_hit;
 mod path;
 mod path_batch;
@@ -66,7 +67,7 @@ impl Integrator {
         assert_eq!(samples.len(), out.len(), "li_batch: one radiance per sample");
         match self {
             Integrator::Path(s) => path_batch::li_batch(s, scene, traversal, samples, out, counters),
-            _ => {
+            Integrator::Whitted(_) | Integrator::Direct(_) | Integrator::Volpath(_) => {
                 for (cs, o) in samples.iter_mut().zip(out.iter_mut()) {
                     *o = self.li(scene, &cs.ray, &mut cs.sampler, counters);
                 }

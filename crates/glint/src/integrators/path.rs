@@ -9,10 +9,11 @@
 //! reference); `path_batch` traces many paths' rays together. Both run the same steps in the
 //! same order, so a path's radiance is the same bits either way.
 
+use super::estimators::{add_emitted, add_environment, sample_light, PrevEvent};
 use super::surface::{passes_mask, transmittance};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
-use crate::math::{Ray, Rgb, Vec3};
+use crate::math::{Ray, Rgb};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::world::{Hit, World};
 
@@ -57,11 +58,10 @@ pub(crate) struct PathState {
     eta_scale: f32,
     /// The ray to trace next (when `tracing`).
     pub ray: Ray,
-    /// Density of the BSDF sample that produced `ray` (solid angle) and whether it was
-    /// delta; the camera ray behaves like a delta sample (nothing else could have produced it).
-    prev_pdf: f32,
-    prev_delta: bool,
-    prev_p: Vec3,
+    /// The BSDF sample that produced `ray`: its density (solid angle), whether it was delta,
+    /// and where; the camera ray behaves like a delta sample (nothing else could have
+    /// produced it).
+    prev: PrevEvent,
     /// Segments traced so far.
     pub depth: u32,
     mask_passes: u32,
@@ -80,9 +80,7 @@ impl PathState {
             throughput: Rgb::WHITE,
             eta_scale: 1.0,
             ray: *camera_ray,
-            prev_pdf: 1.0,
-            prev_delta: true,
-            prev_p: camera_ray.origin,
+            prev: PrevEvent { pdf: 1.0, delta: true, p: camera_ray.origin },
             depth: 0,
             mask_passes: 0,
             max_depth,
@@ -128,17 +126,7 @@ impl PathState {
         let ray = self.ray;
         let Some(hit) = hit else {
             if !(self.depth == 1 && s.hide_emitters) {
-                for &li_idx in &scene.environment_lights {
-                    let light = &scene.lights[li_idx as usize];
-                    let le = light.environment(ray.dir);
-                    if le.is_black() {
-                        continue;
-                    }
-                    let w = emitter_weight(s.strategy, self.prev_delta, self.prev_pdf, || {
-                        scene.light_pmf(li_idx) * light.pdf_li(self.prev_p, ray.dir, ray.origin, ray.dir)
-                    });
-                    self.l += self.throughput * le * w;
-                }
+                add_environment(scene, &ray, s.strategy, &self.prev, self.throughput, &mut self.l);
             }
             return;
         };
@@ -146,14 +134,7 @@ impl PathState {
 
         if let Some(li_idx) = si.light {
             if !(self.depth == 1 && s.hide_emitters) {
-                let light = &scene.lights[li_idx as usize];
-                let le = scene.emitted(&si, ray.dir);
-                if !le.is_black() {
-                    let w = emitter_weight(s.strategy, self.prev_delta, self.prev_pdf, || {
-                        scene.light_pmf(li_idx) * light.pdf_li(self.prev_p, ray.dir, si.p, si.ng)
-                    });
-                    self.l += self.throughput * le * w;
-                }
+                add_emitted(scene, &si, &ray, li_idx, s.strategy, &self.prev, self.throughput, &mut self.l);
             }
         }
         // A masked surface lets the path through unscattered with probability 1 - opacity.
@@ -176,33 +157,23 @@ impl PathState {
 
         // Next-event estimation: one light, chosen by the scene's light distribution.
         if s.strategy != Strategy::Bsdf && !bsdf.is_delta() {
-            if let Some(dist) = &scene.light_distribution {
-                // One 2D point picks the light (its first coordinate, rescaled) and the point
-                // on it, as Mitsuba does: the sampler's 2D stratification then holds within
-                // each light's share of the samples.
-                let u = rng.next_2d();
-                let pick = dist.sample(u[0]);
-                let light = &scene.lights[pick.index];
-                if let Some(ls) = light.sample_li(si.p, [pick.remapped, u[1]]) {
-                    if ls.pdf > 0.0 && !ls.radiance.is_black() {
-                        let wi = frame.to_local(ls.wi);
-                        let f = bsdf.eval(wo, wi);
-                        if !f.is_black() {
-                            c.shadow_rays += 1;
-                            let light_pdf = pick.pmf * ls.pdf;
-                            let mis_weight = if ls.delta || s.strategy == Strategy::Light {
-                                1.0
-                            } else {
-                                power_heuristic(light_pdf, bsdf.pdf(wo, wi))
-                            };
-                            self.shadow = Some(ShadowQuery {
-                                ray: shadow_ray(&si, ls.wi, ls.dist),
-                                contribution: self.throughput * f * ls.radiance,
-                                mis_weight,
-                                light_pdf,
-                            });
-                        }
-                    }
+            if let Some((ls, pick_pmf)) = sample_light(scene, si.p, rng) {
+                let wi = frame.to_local(ls.wi);
+                let f = bsdf.eval(wo, wi);
+                if !f.is_black() {
+                    c.shadow_rays += 1;
+                    let light_pdf = pick_pmf * ls.pdf;
+                    let mis_weight = if ls.delta || s.strategy == Strategy::Light {
+                        1.0
+                    } else {
+                        power_heuristic(light_pdf, bsdf.pdf(wo, wi))
+                    };
+                    self.shadow = Some(ShadowQuery {
+                        ray: shadow_ray(&si, ls.wi, ls.dist),
+                        contribution: self.throughput * f * ls.radiance,
+                        mis_weight,
+                        light_pdf,
+                    });
                 }
             }
         }
@@ -219,9 +190,7 @@ impl PathState {
         self.throughput *= bs.weight;
         self.eta_scale *= bs.eta * bs.eta;
         let wi_world = frame.to_world(bs.wi);
-        self.prev_pdf = bs.pdf;
-        self.prev_delta = bs.delta;
-        self.prev_p = si.p;
+        self.prev = PrevEvent { pdf: bs.pdf, delta: bs.delta, p: si.p };
         self.ray = spawn_ray(&si, wi_world);
 
         if self.depth >= s.rr_depth {
@@ -235,19 +204,5 @@ impl PathState {
             self.throughput = self.throughput / q;
         }
         self.tracing = true;
-    }
-}
-
-/// MIS weight of an emitter reached by a BSDF-sampled ray. `light_pdf` is only evaluated
-/// when needed (it costs a distribution lookup).
-#[inline]
-fn emitter_weight(strategy: Strategy, prev_delta: bool, prev_pdf: f32, light_pdf: impl FnOnce() -> f32) -> f32 {
-    if prev_delta {
-        return 1.0;
-    }
-    match strategy {
-        Strategy::Bsdf => 1.0,
-        Strategy::Light => 0.0,
-        Strategy::Mis => power_heuristic(prev_pdf, light_pdf()),
     }
 }

@@ -22,13 +22,13 @@
 //! extinction from a density grid) sample distances by delta tracking and estimate shadow
 //! rays' transmittance by ratio tracking, both against the grid's majorant.
 
+use super::estimators::{add_emitted, add_environment, sample_light, PrevEvent};
 use super::path::MAX_PATH_DEPTH;
 use super::surface::opacity;
 use super::{shading, shadow_ray, spawn_ray, Counters};
-use crate::bsdf::{Bsdf, BsdfSample, Null};
-use crate::describe::VolpathSettings;
-use crate::lights::LightSample;
-use crate::math::{offset_origin, Ray, Rgb, Vec3};
+use crate::bsdf::{Bsdf, BsdfSample, ShadedBsdf};
+use crate::describe::{Strategy, VolpathSettings};
+use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::media::{sample_distance, Medium};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::world::{SurfaceInteraction, World};
@@ -52,9 +52,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
     let mut medium = scene.camera_medium;
     // The last scattering event: its direction density, whether it was delta (or could not
     // have been sampled by lights), and where it was.
-    let mut prev_pdf = 1.0f32;
-    let mut prev_delta = true;
-    let mut prev_p = ray.origin;
+    let mut prev = PrevEvent { pdf: 1.0, delta: true, p: ray.origin };
     let mut depth = 0u32; // scattering events so far
     let mut passages = 0u32;
     // The hero channel, and each channel's path density over their mean (`throughput` is the
@@ -90,10 +88,10 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
                     l += throughput * light_at_medium_point(scene, m, p, wo, medium, passable, rng, c);
                 }
                 let ps = m.phase.sample(wo, rng.next_2d());
-                prev_pdf = ps.pdf;
+                prev.pdf = ps.pdf;
                 // Without light sampling here, lights the phase sample reaches count fully.
-                prev_delta = !m.sample_emitters;
-                prev_p = p;
+                prev.delta = !m.sample_emitters;
+                prev.p = p;
                 ray = Ray::new(p, ps.wi);
                 if !roulette(s, depth, &mut throughput, eta_scale, rng) {
                     break;
@@ -104,17 +102,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
 
         let Some(hit) = hit else {
             if !(depth == 0 && s.hide_emitters) {
-                for &li_idx in &scene.environment_lights {
-                    let light = &scene.lights[li_idx as usize];
-                    let le = light.environment(ray.dir);
-                    if le.is_black() {
-                        continue;
-                    }
-                    let w = emitter_weight(prev_delta, prev_pdf, || {
-                        scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, ray.origin, ray.dir)
-                    });
-                    l += throughput * le * w;
-                }
+                add_environment(scene, &ray, Strategy::Mis, &prev, throughput, &mut l);
             }
             break;
         };
@@ -131,14 +119,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
                 ray = spawn_ray(&si, ray.dir);
                 continue;
             }
-            let light = &scene.lights[li_idx as usize];
-            let le = scene.emitted(&si, ray.dir);
-            if !le.is_black() {
-                let w = emitter_weight(prev_delta, prev_pdf, || {
-                    scene.light_pmf(li_idx) * light.pdf_li(prev_p, ray.dir, si.p, si.ng)
-                });
-                l += throughput * le * w;
-            }
+            add_emitted(scene, &si, &ray, li_idx, Strategy::Mis, &prev, throughput, &mut l);
         }
 
         // A masked surface lets the path through unscattered with probability 1 - opacity:
@@ -162,19 +143,8 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
 
         // Next-event estimation, when one more segment is allowed.
         if !bsdf.is_delta() && depth + 1 < max_depth {
-            if let Some((ls, pick_pmf)) = sample_light(scene, si.p, rng) {
-                let wi = frame.to_local(ls.wi);
-                let f = bsdf.eval(wo, wi);
-                if !f.is_black() {
-                    let start = boundary.medium_after(ls.wi.dot(si.ng), medium);
-                    let tr = transmittance(scene, shadow_ray(&si, ls.wi, ls.dist), start, passable, rng, c);
-                    if !tr.is_black() {
-                        let light_pdf = pick_pmf * ls.pdf;
-                        let w = if ls.delta { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
-                        l += throughput * f * ls.radiance * tr * (w / light_pdf);
-                    }
-                }
-            }
+            let at = SurfacePoint { si: &si, bsdf: &bsdf, frame: &frame, wo, medium, passable };
+            add_light_at_surface(scene, &at, throughput, &mut l, rng, c);
         }
 
         let u_lobe = rng.next_f32();
@@ -202,14 +172,54 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
         }
         depth += 1;
         eta_scale *= bs.eta * bs.eta;
-        prev_pdf = bs.pdf;
-        prev_delta = bs.delta;
-        prev_p = si.p;
+        prev = PrevEvent { pdf: bs.pdf, delta: bs.delta, p: si.p };
         if !roulette(s, depth, &mut throughput, eta_scale, rng) {
             break;
         }
     }
     l
+}
+
+/// A surface scattering point as next-event estimation sees it.
+struct SurfacePoint<'a> {
+    si: &'a SurfaceInteraction,
+    bsdf: &'a ShadedBsdf,
+    frame: &'a Frame,
+    wo: Vec3,
+    /// The medium the path arrived in.
+    medium: Option<u32>,
+    /// Whether shadow rays must look for passages.
+    passable: bool,
+}
+
+/// Adds to `l` one light sample's contribution at a surface point times `throughput`,
+/// MIS-weighted against BSDF sampling.
+fn add_light_at_surface(
+    scene: &World,
+    at: &SurfacePoint,
+    throughput: Rgb,
+    l: &mut Rgb,
+    rng: &mut Sampler,
+    c: &mut Counters,
+) {
+    let (si, bsdf, wo) = (at.si, at.bsdf, at.wo);
+    let Some((ls, pick_pmf)) = sample_light(scene, si.p, rng) else {
+        return;
+    };
+    let wi = at.frame.to_local(ls.wi);
+    let f = bsdf.eval(wo, wi);
+    if f.is_black() {
+        return;
+    }
+    let boundary = scene.instances[si.instance as usize].media;
+    let start = boundary.medium_after(ls.wi.dot(si.ng), at.medium);
+    let tr = transmittance(scene, shadow_ray(si, ls.wi, ls.dist), start, at.passable, rng, c);
+    if tr.is_black() {
+        return;
+    }
+    let light_pdf = pick_pmf * ls.pdf;
+    let w = if ls.delta { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
+    *l += throughput * f * ls.radiance * tr * (w / light_pdf);
 }
 
 /// Russian roulette from `rr_depth` scattering events on; false when the path ends.
@@ -224,19 +234,6 @@ fn roulette(s: &VolpathSettings, depth: u32, throughput: &mut Rgb, eta_scale: f3
     }
     *throughput = *throughput / q;
     true
-}
-
-/// One light sample from `p`, with the probability of having picked that light.
-fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
-    let dist = scene.light_distribution.as_ref()?;
-    // The light and the point on it from one 2D point (see path.rs).
-    let u = rng.next_2d();
-    let pick = dist.sample(u[0]);
-    let ls = scene.lights[pick.index].sample_li(p, [pick.remapped, u[1]])?;
-    if !(ls.pdf > 0.0) || ls.radiance.is_black() {
-        return None;
-    }
-    Some((ls, pick.pmf))
 }
 
 /// Next-event estimation at a scattering point `p` in medium `m` (index `medium`).
@@ -297,7 +294,7 @@ fn transmittance(
         }
         let si = scene.interaction(&ray, &hit);
         let (bsdf, frame) = shading(scene, &si, -ray.dir);
-        let through = passage_transmission(&bsdf.bsdf, frame.to_local(-ray.dir));
+        let through = bsdf.bsdf.passage_transmission(frame.to_local(-ray.dir));
         // A mask passes 1 - opacity unscattered; the surface beneath it passes its share
         // of the rest if it is itself a passage.
         let o = if scene.has_masks { opacity(scene, &si) } else { 1.0 };
@@ -333,33 +330,7 @@ fn next_segment(si: &SurfaceInteraction, ray: &Ray, t: f32) -> Ray {
     Ray::segment(o, to_target / len, len)
 }
 
-/// What a passage lets straight through towards `-wo`: all of it for `null`, the summed
-/// transmission of a thin dielectric (Mitsuba's null transmission); `None` for surfaces
-/// that are not passages.
-fn passage_transmission(bsdf: &Bsdf, wo: Vec3) -> Option<Rgb> {
-    match bsdf {
-        Bsdf::Null(Null) => Some(Rgb::WHITE),
-        Bsdf::ThinDielectric(thin) => Some(thin.transmit * (1.0 - thin.reflectance(wo.z))),
-        _ => None,
-    }
-}
-
 /// Whether a BSDF sample went straight through a passage (not a scattering event).
 fn is_passage(bsdf: &Bsdf, wo: Vec3, bs: &BsdfSample) -> bool {
-    match bsdf {
-        Bsdf::Null(Null) => true,
-        Bsdf::ThinDielectric(_) => bs.delta && bs.wi == -wo,
-        _ => false,
-    }
-}
-
-/// MIS weight of an emitter reached by a sampled direction (`light_pdf` evaluated only when
-/// needed).
-#[inline]
-fn emitter_weight(prev_delta: bool, prev_pdf: f32, light_pdf: impl FnOnce() -> f32) -> f32 {
-    if prev_delta {
-        1.0
-    } else {
-        power_heuristic(prev_pdf, light_pdf())
-    }
+    bsdf.passage_transmission(wo).is_some() && bs.delta && bs.wi == -wo
 }

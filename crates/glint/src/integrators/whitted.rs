@@ -111,49 +111,45 @@ fn shade(s: &WhittedSettings, scene: &World, ray: &Ray, rng: &mut Sampler, c: &m
     let wo = frame.to_local(wo_world);
     let can_recurse = depth < s.max_depth;
 
-    match bsdf.bsdf {
-        Bsdf::Dielectric(Dielectric { eta, reflect, transmit }) => {
-            if can_recurse {
-                let fr = fresnel_dielectric(wo.z, eta);
-                let r_dir = frame.to_world(reflect_local(wo));
-                let refraction = (fr.reflectance < 1.0).then(|| Refraction {
-                    ray: spawn_ray(&si, frame.to_world(refract_local(wo, &fr))),
-                    transmit,
-                    scale: (1.0 - fr.reflectance) / (fr.eta_ti * fr.eta_ti),
-                });
-                let waiting = Waiting::Reflection { reflect, reflectance: fr.reflectance, refraction };
-                return Node::Branch(Frame { l, waiting }, spawn_ray(&si, r_dir));
+    if let Bsdf::Dielectric(Dielectric { eta, reflect, transmit }) = bsdf.bsdf {
+        if can_recurse {
+            let fr = fresnel_dielectric(wo.z, eta);
+            let r_dir = frame.to_world(reflect_local(wo));
+            let refraction = (fr.reflectance < 1.0).then(|| Refraction {
+                ray: spawn_ray(&si, frame.to_world(refract_local(wo, &fr))),
+                transmit,
+                scale: (1.0 - fr.reflectance) / (fr.eta_ti * fr.eta_ti),
+            });
+            let waiting = Waiting::Reflection { reflect, reflectance: fr.reflectance, refraction };
+            return Node::Branch(Frame { l, waiting }, spawn_ray(&si, r_dir));
+        }
+    } else if bsdf.is_delta() {
+        // Mirrors (and other delta BSDFs): follow the sampled delta direction.
+        if can_recurse {
+            if let Some(bs) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
+                let dir = frame.to_world(bs.wi);
+                let waiting = Waiting::Delta { weight: bs.weight };
+                return Node::Branch(Frame { l, waiting }, spawn_ray(&si, dir));
             }
         }
-        _ if bsdf.is_delta() => {
-            // Mirrors (and other delta BSDFs): follow the sampled delta direction.
-            if can_recurse {
-                if let Some(bs) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
-                    let dir = frame.to_world(bs.wi);
-                    let waiting = Waiting::Delta { weight: bs.weight };
-                    return Node::Branch(Frame { l, waiting }, spawn_ray(&si, dir));
-                }
+    } else {
+        // Diffuse and glossy: direct light only, one sample per light.
+        for light in &scene.lights {
+            let Some(ls) = light.sample_li(si.p, rng.next_2d()) else {
+                continue;
+            };
+            if ls.pdf <= 0.0 || ls.radiance.is_black() {
+                continue;
             }
-        }
-        _ => {
-            // Diffuse and glossy: direct light only, one sample per light.
-            for light in &scene.lights {
-                let Some(ls) = light.sample_li(si.p, rng.next_2d()) else {
-                    continue;
-                };
-                if ls.pdf <= 0.0 || ls.radiance.is_black() {
-                    continue;
-                }
-                let f = bsdf.eval(wo, frame.to_local(ls.wi));
-                if f.is_black() {
-                    continue;
-                }
-                c.shadow_rays += 1;
-                // Exactly 0 or 1 where no mask is on the way, and times 1 keeps the bits.
-                let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
-                if visible > 0.0 {
-                    l += f * ls.radiance / ls.pdf * visible;
-                }
+            let f = bsdf.eval(wo, frame.to_local(ls.wi));
+            if f.is_black() {
+                continue;
+            }
+            c.shadow_rays += 1;
+            // Exactly 0 or 1 where no mask is on the way, and times 1 keeps the bits.
+            let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
+            if visible > 0.0 {
+                l += f * ls.radiance / ls.pdf * visible;
             }
         }
     }
@@ -224,46 +220,42 @@ mod tests {
         let wo = frame.to_local(wo_world);
         let can_recurse = depth < s.max_depth;
 
-        match bsdf.bsdf {
-            Bsdf::Dielectric(Dielectric { eta, reflect, transmit }) => {
-                if can_recurse {
-                    let fr = fresnel_dielectric(wo.z, eta);
-                    let r_dir = frame.to_world(reflect_local(wo));
-                    l += reflect * trace(s, scene, &spawn_ray(&si, r_dir), rng, c, depth + 1) * fr.reflectance;
-                    if fr.reflectance < 1.0 {
-                        let t_dir = frame.to_world(refract_local(wo, &fr));
-                        let scale = (1.0 - fr.reflectance) / (fr.eta_ti * fr.eta_ti);
-                        l += transmit * trace(s, scene, &spawn_ray(&si, t_dir), rng, c, depth + 1) * scale;
-                    }
+        if let Bsdf::Dielectric(Dielectric { eta, reflect, transmit }) = bsdf.bsdf {
+            if can_recurse {
+                let fr = fresnel_dielectric(wo.z, eta);
+                let r_dir = frame.to_world(reflect_local(wo));
+                l += reflect * trace(s, scene, &spawn_ray(&si, r_dir), rng, c, depth + 1) * fr.reflectance;
+                if fr.reflectance < 1.0 {
+                    let t_dir = frame.to_world(refract_local(wo, &fr));
+                    let scale = (1.0 - fr.reflectance) / (fr.eta_ti * fr.eta_ti);
+                    l += transmit * trace(s, scene, &spawn_ray(&si, t_dir), rng, c, depth + 1) * scale;
                 }
             }
-            _ if bsdf.is_delta() => {
-                // Mirrors (and other delta BSDFs): follow the sampled delta direction.
-                if can_recurse {
-                    if let Some(bs) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
-                        let dir = frame.to_world(bs.wi);
-                        l += bs.weight * trace(s, scene, &spawn_ray(&si, dir), rng, c, depth + 1);
-                    }
+        } else if bsdf.is_delta() {
+            // Mirrors (and other delta BSDFs): follow the sampled delta direction.
+            if can_recurse {
+                if let Some(bs) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
+                    let dir = frame.to_world(bs.wi);
+                    l += bs.weight * trace(s, scene, &spawn_ray(&si, dir), rng, c, depth + 1);
                 }
             }
-            _ => {
-                // Diffuse and glossy: direct light only, one sample per light.
-                for light in &scene.lights {
-                    let Some(ls) = light.sample_li(si.p, rng.next_2d()) else {
-                        continue;
-                    };
-                    if ls.pdf <= 0.0 || ls.radiance.is_black() {
-                        continue;
-                    }
-                    let f = bsdf.eval(wo, frame.to_local(ls.wi));
-                    if f.is_black() {
-                        continue;
-                    }
-                    c.shadow_rays += 1;
-                    let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
-                    if visible > 0.0 {
-                        l += f * ls.radiance / ls.pdf * visible;
-                    }
+        } else {
+            // Diffuse and glossy: direct light only, one sample per light.
+            for light in &scene.lights {
+                let Some(ls) = light.sample_li(si.p, rng.next_2d()) else {
+                    continue;
+                };
+                if ls.pdf <= 0.0 || ls.radiance.is_black() {
+                    continue;
+                }
+                let f = bsdf.eval(wo, frame.to_local(ls.wi));
+                if f.is_black() {
+                    continue;
+                }
+                c.shadow_rays += 1;
+                let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
+                if visible > 0.0 {
+                    l += f * ls.radiance / ls.pdf * visible;
                 }
             }
         }

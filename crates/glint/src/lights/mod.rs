@@ -231,7 +231,12 @@ impl Light {
             Light::Mesh { emitter, .. } => emitter.total_area,
             Light::Sphere { sphere, .. } => sphere.area(),
             Light::Cylinder { cylinder, .. } => cylinder.area(),
-            _ => 0.0,
+            Light::Point { .. }
+            | Light::Spot { .. }
+            | Light::Directional { .. }
+            | Light::Constant { .. }
+            | Light::EnvMap(_)
+            | Light::Projected(_) => 0.0,
         }
     }
 
@@ -394,7 +399,7 @@ impl Light {
             }
             Light::Constant { .. } => warp::UNIFORM_SPHERE_PDF,
             Light::EnvMap(env) => env.pdf(wi),
-            _ => 0.0,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } | Light::Projected(_) => 0.0,
         }
     }
 
@@ -404,7 +409,12 @@ impl Light {
         let (radiance, two_sided) = match self {
             Light::Mesh { radiance, two_sided, .. } => (radiance, *two_sided),
             Light::Sphere { radiance, .. } | Light::Cylinder { radiance, .. } => (radiance, false),
-            _ => return Rgb::BLACK,
+            Light::Point { .. }
+            | Light::Spot { .. }
+            | Light::Directional { .. }
+            | Light::Constant { .. }
+            | Light::EnvMap(_)
+            | Light::Projected(_) => return Rgb::BLACK,
         };
         if two_sided || n.dot(wi) < 0.0 {
             radiance_at(radiance, || *at)
@@ -418,7 +428,13 @@ impl Light {
         match self {
             Light::Constant { radiance, .. } => *radiance,
             Light::EnvMap(env) => env.eval(dir),
-            _ => Rgb::BLACK,
+            Light::Point { .. }
+            | Light::Spot { .. }
+            | Light::Directional { .. }
+            | Light::Mesh { .. }
+            | Light::Sphere { .. }
+            | Light::Cylinder { .. }
+            | Light::Projected(_) => Rgb::BLACK,
         }
     }
 }

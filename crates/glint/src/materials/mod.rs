@@ -159,7 +159,16 @@ impl MaterialKind {
             | MaterialKind::Null => true,
             MaterialKind::Principled(p) => p.is_transmissive(),
             MaterialKind::Blend(b) => b.is_transmissive(),
-            _ => false,
+            MaterialKind::Diffuse { .. }
+            | MaterialKind::Phong { .. }
+            | MaterialKind::Conductor { .. }
+            | MaterialKind::RoughConductor { .. }
+            | MaterialKind::Plastic { .. }
+            | MaterialKind::PPlastic { .. }
+            | MaterialKind::Black
+            | MaterialKind::NormalMap { .. }
+            | MaterialKind::BumpMap { .. }
+            | MaterialKind::Mask { .. } => false,
         }
     }
 
@@ -176,7 +185,10 @@ impl MaterialKind {
             MaterialKind::Null => Rgb::WHITE,
             MaterialKind::Principled(p) => p.base_color.eval(uv),
             MaterialKind::Blend(b) => b.albedo(uv),
-            _ => Rgb::BLACK,
+            MaterialKind::Black
+            | MaterialKind::NormalMap { .. }
+            | MaterialKind::BumpMap { .. }
+            | MaterialKind::Mask { .. } => Rgb::BLACK,
         }
     }
 

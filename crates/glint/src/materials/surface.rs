@@ -11,27 +11,41 @@ pub enum Perturbation<'a> {
 }
 
 impl MaterialKind {
-    /// The material inside every normal map, bump map and mask: the one that scatters.
-    pub fn base(&self) -> &MaterialKind {
-        let mut k = self;
-        loop {
-            match k {
-                MaterialKind::NormalMap { nested, .. }
-                | MaterialKind::BumpMap { nested, .. }
-                | MaterialKind::Mask { nested, .. } => k = nested,
-                other => return other,
-            }
+    /// The material a normal map, bump map or mask wraps; `None` for a material that
+    /// scatters.
+    pub fn nested(&self) -> Option<&MaterialKind> {
+        match self {
+            MaterialKind::NormalMap { nested, .. }
+            | MaterialKind::BumpMap { nested, .. }
+            | MaterialKind::Mask { nested, .. } => Some(nested),
+            MaterialKind::Diffuse { .. }
+            | MaterialKind::Phong { .. }
+            | MaterialKind::Conductor { .. }
+            | MaterialKind::RoughConductor { .. }
+            | MaterialKind::Dielectric { .. }
+            | MaterialKind::RoughDielectric { .. }
+            | MaterialKind::ThinDielectric { .. }
+            | MaterialKind::Plastic { .. }
+            | MaterialKind::Black
+            | MaterialKind::Null
+            | MaterialKind::Principled(_)
+            | MaterialKind::Blend(_)
+            | MaterialKind::PPlastic { .. } => None,
         }
     }
 
-    /// The wrappers from the outside in, as (kind) references, ending before the base.
+    /// The material inside every normal map, bump map and mask: the one that scatters.
+    pub fn base(&self) -> &MaterialKind {
+        let mut k = self;
+        while let Some(nested) = k.nested() {
+            k = nested;
+        }
+        k
+    }
+
+    /// The wrappers from the outside in, as (kind) references, then the base.
     fn wrappers(&self) -> impl Iterator<Item = &MaterialKind> {
-        std::iter::successors(Some(self), |k| match k {
-            MaterialKind::NormalMap { nested, .. }
-            | MaterialKind::BumpMap { nested, .. }
-            | MaterialKind::Mask { nested, .. } => Some(&**nested),
-            _ => None,
-        })
+        std::iter::successors(Some(self), |k| k.nested())
     }
 }
 
@@ -39,10 +53,14 @@ impl Material {
     /// The normal or bump map of the material, if it has one (the reader accepts at most
     /// one per material).
     pub fn perturbation(&self) -> Option<Perturbation<'_>> {
-        self.kind.wrappers().find_map(|k| match k {
-            MaterialKind::NormalMap { normals, .. } => Some(Perturbation::NormalMap { normals }),
-            MaterialKind::BumpMap { height, scale, .. } => Some(Perturbation::BumpMap { height, scale: *scale }),
-            _ => None,
+        self.kind.wrappers().find_map(|k| {
+            if let MaterialKind::NormalMap { normals, .. } = k {
+                return Some(Perturbation::NormalMap { normals });
+            }
+            if let MaterialKind::BumpMap { height, scale, .. } = k {
+                return Some(Perturbation::BumpMap { height, scale: *scale });
+            }
+            None
         })
     }
 

@@ -35,7 +35,16 @@ impl<'a> Reader<'a> {
                 match m {
                     MaterialModel::NormalMap { .. } | MaterialModel::BumpMap { .. } => return true,
                     MaterialModel::Mask { nested, .. } => m = nested,
-                    _ => return false,
+                    MaterialModel::Diffuse { .. }
+                    | MaterialModel::Phong { .. }
+                    | MaterialModel::Conductor { .. }
+                    | MaterialModel::Dielectric { .. }
+                    | MaterialModel::Plastic { .. }
+                    | MaterialModel::Black
+                    | MaterialModel::Null
+                    | MaterialModel::Principled(_)
+                    | MaterialModel::Blend(_)
+                    | MaterialModel::PPlastic { .. } => return false,
                 }
             }
         };

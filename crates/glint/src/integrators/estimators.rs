@@ -1,0 +1,93 @@
+//! Estimator pieces the path tracers share: choosing a light and a point on it for
+//! next-event estimation, the MIS weight of an emitter that a sampled direction reaches, and
+//! what the environment lights and a hit area light send back along a path. The direct
+//! integrator weights by its sample counts and the Whitted integrator does not weight, so
+//! they keep their own.
+
+use crate::describe::Strategy;
+use crate::lights::LightSample;
+use crate::math::{Ray, Rgb, Vec3};
+use crate::sampling::{power_heuristic, Sampler};
+use crate::world::{SurfaceInteraction, World};
+
+/// The last scattering event of a path: the density its sampled direction had, whether it
+/// was delta (or could not have been sampled by lights), and where it was.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrevEvent {
+    pub pdf: f32,
+    pub delta: bool,
+    pub p: Vec3,
+}
+
+/// A light chosen by the scene's light distribution and a point on it, both from one 2D
+/// point (its first coordinate picks the light and, rescaled, drives the point with the
+/// second, as Mitsuba does: the sampler's 2D stratification then holds within each light's
+/// share of the samples); `None` without lights, or when the sample carries nothing. The
+/// second value is the probability of choosing the light.
+pub(crate) fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
+    let dist = scene.light_distribution.as_ref()?;
+    let u = rng.next_2d();
+    let pick = dist.sample(u[0]);
+    let ls = scene.lights[pick.index].sample_li(p, [pick.remapped, u[1]])?;
+    if !(ls.pdf > 0.0) || ls.radiance.is_black() {
+        return None;
+    }
+    Some((ls, pick.pmf))
+}
+
+/// MIS weight of an emitter reached by a sampled direction (`light_pdf`, the density light
+/// sampling would have had, evaluated only when needed).
+#[inline]
+pub(crate) fn emitter_weight(strategy: Strategy, prev: &PrevEvent, light_pdf: impl FnOnce() -> f32) -> f32 {
+    if prev.delta {
+        return 1.0;
+    }
+    match strategy {
+        Strategy::Bsdf => 1.0,
+        Strategy::Light => 0.0,
+        Strategy::Mis => power_heuristic(prev.pdf, light_pdf()),
+    }
+}
+
+/// Adds to `l` what the environment lights send along an escaped `ray`, times `throughput`.
+pub(crate) fn add_environment(
+    scene: &World,
+    ray: &Ray,
+    strategy: Strategy,
+    prev: &PrevEvent,
+    throughput: Rgb,
+    l: &mut Rgb,
+) {
+    for &li_idx in &scene.environment_lights {
+        let light = &scene.lights[li_idx as usize];
+        let le = light.environment(ray.dir);
+        if le.is_black() {
+            continue;
+        }
+        let w = emitter_weight(strategy, prev, || {
+            scene.light_pmf(li_idx) * light.pdf_li(prev.p, ray.dir, ray.origin, ray.dir)
+        });
+        *l += throughput * le * w;
+    }
+}
+
+/// Adds to `l` what the area light `li_idx`, hit at `si`, emits back along `ray`, times
+/// `throughput`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn add_emitted(
+    scene: &World,
+    si: &SurfaceInteraction,
+    ray: &Ray,
+    li_idx: u32,
+    strategy: Strategy,
+    prev: &PrevEvent,
+    throughput: Rgb,
+    l: &mut Rgb,
+) {
+    let light = &scene.lights[li_idx as usize];
+    let le = scene.emitted(si, ray.dir);
+    if !le.is_black() {
+        let w = emitter_weight(strategy, prev, || scene.light_pmf(li_idx) * light.pdf_li(prev.p, ray.dir, si.p, si.ng));
+        *l += throughput * le * w;
+    }
+}
