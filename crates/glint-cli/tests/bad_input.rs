@@ -176,6 +176,29 @@ fn zero_and_absurd_resolutions() {
 }
 
 #[test]
+fn degenerate_transforms_are_refused_in_one_line() {
+    let f = Fixture::new("scale");
+    for scale in ["1e-40", "1e38", "[1, 1e-25, 1]"] {
+        let shape = format!(r#"{{ "type": "cube", "material": "white", "transform": [ {{ "scale": {scale} }} ] }}"#);
+        let s = f.write("s.json", scene_json(&shape, "", FILM).as_bytes());
+        let out = f.dir.join("o.png");
+        let e = fails(&render_args(s.to_str().unwrap(), out.to_str().unwrap()), &out);
+        assert!(e.contains("s.json:") && e.contains("degenerate") && e.trim().lines().count() == 1, "{scale}: {e}");
+    }
+    // Large and small scales within range render.
+    for scale in ["1e-6", "1e6"] {
+        let shape = format!(r#"{{ "type": "cube", "material": "white", "transform": [ {{ "scale": {scale} }} ] }}"#);
+        let s = f.write("ok.json", scene_json(&shape, "", FILM).as_bytes());
+        let out = f.dir.join("ok.png");
+        let o = Command::new(env!("CARGO_BIN_EXE_glint"))
+            .args(render_args(s.to_str().unwrap(), out.to_str().unwrap()))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{scale}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+}
+
+#[test]
 fn bad_flags_and_outputs() {
     let f = Fixture::new("flags");
     let s = f.write("s.json", scene_json(r#"{ "type": "sphere", "material": "white" }"#, "", FILM).as_bytes());
@@ -218,6 +241,24 @@ fn good_scene_renders_and_writes_the_file() {
         .output()
         .unwrap();
     assert!(o.status.success() && o.stderr.is_empty() && o.stdout.is_empty());
+}
+
+#[test]
+fn without_an_output_the_image_goes_next_to_the_scene_and_help_names_every_format() {
+    let f = Fixture::new("default-out");
+    let s = f.write("box.json", scene_json(r#"{ "type": "sphere", "material": "white" }"#, "", FILM).as_bytes());
+    let o =
+        Command::new(env!("CARGO_BIN_EXE_glint")).args(["render", s.to_str().unwrap(), "--spp", "1"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    let written = f.dir.join("box.png");
+    assert!(written.exists(), "{stderr}");
+    assert!(stderr.contains(&format!("-> {}", written.display())), "the summary says where: {stderr}");
+    let help = Command::new(env!("CARGO_BIN_EXE_glint")).args(["render", "--help"]).output().unwrap();
+    let help = String::from_utf8_lossy(&help.stdout);
+    for format in [".json", ".xml", ".obj", ".ply", "Mitsuba"] {
+        assert!(help.contains(format), "render --help names {format}: {help}");
+    }
 }
 
 /// A Mitsuba scene with several unsupported features: one line each, every one with file and

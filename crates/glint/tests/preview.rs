@@ -169,8 +169,11 @@ fn the_stop_button_stops_the_render_after_a_pass() {
     assert!(body(&get(addr, "/state")).contains("\"state\":\"stopped\""));
 }
 
-/// A tev that keeps every packet it receives: (type, payload after the type).
-fn fake_tev() -> (SocketAddr, std::thread::JoinHandle<Vec<(u8, Vec<u8>)>>) {
+/// Packets as (type, payload after the type).
+type Packets = Vec<(u8, Vec<u8>)>;
+
+/// A tev that keeps every packet it receives.
+fn fake_tev() -> (SocketAddr, std::thread::JoinHandle<Packets>) {
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let addr = listener.local_addr().unwrap();
     let handle = std::thread::spawn(move || {

@@ -4,6 +4,7 @@ codes (130 after Ctrl-C, 143 after SIGTERM, having written the image so far)."""
 
 import argparse
 import math
+import os
 import signal
 import sys
 import time
@@ -20,7 +21,8 @@ def _parser() -> argparse.ArgumentParser:
         prog="python -m glint.distributed", description="Render a scene on a Ray cluster (as glint render does)."
     )
     p.add_argument("scene", help="scene file (.json, Mitsuba .xml, .obj, .ply)")
-    p.add_argument("-o", "--output", default="out.png", help="output image (.png, .exr or .pfm)")
+    p.add_argument("-o", "--output", help="output image (.png, .exr or .pfm; default: the scene's name with .png, "
+                                          "next to it)")
     p.add_argument("--spp", type=int, help="samples per pixel (default: the scene's)")
     p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument("--integrator", choices=INTEGRATORS, help="integrator (default: the scene's)")
@@ -107,6 +109,8 @@ def _load(a: argparse.Namespace):
 
 def main(argv: Optional[List[str]] = None) -> int:
     a = _parser().parse_args(argv)
+    if a.output is None:
+        a.output = os.path.splitext(a.scene)[0] + ".png"
     # SIGTERM stops the render as Ctrl-C does (the image so far is written).
     got: List[int] = []
 

@@ -378,7 +378,7 @@ fn matrix(m: &Matrix4, what: &str) -> Result<(), String> {
 fn axis_scales(m: &Matrix4, what: &str) -> Result<(), String> {
     let (lo, hi) = ((f32::MIN_POSITIVE as f64).sqrt(), (f32::MAX as f64).sqrt());
     for c in 0..3 {
-        let len = (0..3).map(|r| m[r][c] * m[r][c]).sum::<f64>().sqrt();
+        let len = m[..3].iter().map(|row| row[c] * row[c]).sum::<f64>().sqrt();
         if len != 0.0 && !(lo..=hi).contains(&len) {
             return Err(format!(
                 "{what}: a scale of {len:.3e} along an axis is degenerate (glint traces in f32: scales from {lo:.1e} to {hi:.1e})"
