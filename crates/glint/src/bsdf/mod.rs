@@ -16,6 +16,7 @@
 
 mod blend;
 mod fresnel;
+mod hair;
 mod microfacet;
 mod perturbed;
 mod phong;
@@ -23,6 +24,7 @@ mod principled;
 
 pub use blend::{BlendBsdf, BlendPart};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
+pub use hair::{HairBsdf, EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
 pub use microfacet::{Microfacet, MicrofacetKind};
 pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
 pub use phong::Phong;
@@ -89,6 +91,8 @@ pub enum Bsdf {
     Blend(BlendBsdf),
     /// Mitsuba's `pplastic` as its unpolarized variants render it.
     PPlastic(PPlasticParams),
+    /// Mitsuba's `hair` (Chiang et al. 2016), in a curve's frame (x around, y along).
+    Hair(HairBsdf),
 }
 
 mod plastic;
@@ -145,6 +149,7 @@ impl Bsdf {
             Bsdf::PPlastic(p) => p.eval(wo, wi),
             Bsdf::Principled(p) => p.eval(wo, wi),
             Bsdf::Blend(b) => b.eval(wo, wi),
+            Bsdf::Hair(h) => h.eval(wo, wi),
             Bsdf::Conductor { .. }
             | Bsdf::Dielectric { .. }
             | Bsdf::ThinDielectric { .. }
@@ -177,6 +182,7 @@ impl Bsdf {
             Bsdf::Principled(p) => p.pdf(wo, wi),
             Bsdf::Blend(b) => b.pdf(wo, wi),
             Bsdf::PPlastic(p) => p.pdf(wo, wi),
+            Bsdf::Hair(h) => h.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -253,6 +259,7 @@ impl Bsdf {
             Bsdf::Null => Some(BsdfSample { wi: -wo, weight: Rgb::WHITE, pdf: 1.0, delta: true, eta: 1.0 }),
             Bsdf::Principled(p) => p.sample(wo, u_lobe, u),
             Bsdf::Blend(b) => b.sample(wo, u_lobe, u),
+            Bsdf::Hair(h) => h.sample(wo, u_lobe, u),
         }
     }
 

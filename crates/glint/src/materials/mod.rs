@@ -11,7 +11,7 @@ pub use roughness::RoughnessMap;
 pub use surface::Perturbation;
 pub use texture::{Bitmap, Texture, TexturePoint};
 
-use crate::bsdf::{Bsdf, Microfacet, PPlasticParams, Phong, PlasticParams};
+use crate::bsdf::{Bsdf, HairBsdf, Microfacet, PPlasticParams, Phong, PlasticParams};
 use crate::math::Rgb;
 
 #[derive(Clone, Debug)]
@@ -93,6 +93,8 @@ pub enum MaterialKind {
         dist: RoughnessMap,
         specular_probability: f32,
     },
+    /// Mitsuba's `hair`.
+    Hair(HairBsdf),
 }
 
 #[derive(Clone, Debug)]
@@ -222,6 +224,7 @@ impl MaterialKind {
                     specular_probability: *specular_probability,
                 })
             }
+            MaterialKind::Hair(h) => Bsdf::Hair(*h),
         }
     }
 }

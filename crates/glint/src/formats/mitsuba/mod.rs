@@ -5,6 +5,7 @@
 //! an error that names the plugin, the file and the line.
 
 mod bsdfs_extra;
+mod hair;
 mod instances;
 mod media;
 mod polarized;
@@ -449,6 +450,7 @@ impl<'a> Reader<'a> {
             "principled" => self.principled(&p)?,
             "blendbsdf" => self.blend(&p)?,
             "pplastic" => self.pplastic(&p)?,
+            "hair" => self.hair(&p)?,
             "polarizer" => self.polarizer(&p)?,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };
