@@ -249,7 +249,7 @@ impl HairBsdf {
         let lobes = self.lobes(&inc, wi);
         let mut value = Rgb::BLACK;
         for (a, l) in inc.attenuation.iter().zip(lobes) {
-            value = value + *a * l;
+            value += *a * l;
         }
         if value.r.is_finite() && value.g.is_finite() && value.b.is_finite() {
             value
