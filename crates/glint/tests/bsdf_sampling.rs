@@ -7,8 +7,8 @@ mod common;
 use common::bsdf_check::{chi2_of, dir, draw_samples, integrate, BsdfCase, Integrals, Samples};
 use common::stats::{sidak, z_critical, FALSE_ALARM};
 use glint::bsdf::{
-    normal_map_frame, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong, PlasticParams,
-    Principled, PrincipledInputs, PrincipledRates, ShadedBsdf,
+    normal_map_frame, BlendBsdf, BlendPart, Bsdf, HairBsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong,
+    PlasticParams, Principled, PrincipledInputs, PrincipledRates, ShadedBsdf,
 };
 use glint::bsdf::{Conductor, Diffuse, RoughConductor, RoughDielectric};
 use glint::math::vec3;
@@ -147,7 +147,21 @@ fn cases() -> Vec<BsdfCase> {
         }
     }
     principled_and_blend_cases(&mut v);
+    hair_cases(&mut v);
     v
+}
+
+/// Mitsuba's `hair`, seen from directions along, across and against the fibre (its frame:
+/// x around, y along, z the normal), from near its edge (h near ±1) and head-on.
+fn hair_cases(v: &mut Vec<BsdfCase>) {
+    let brown = HairBsdf::new(HairBsdf::pigment_absorption(1.3, 0.2), 1.55, 0.3, 0.3, 2.0);
+    let blond_rough = HairBsdf::new(HairBsdf::pigment_absorption(0.3, 0.1), 1.55, 0.6, 0.8, 4.0);
+    let clear_smooth = HairBsdf::new(Rgb::BLACK, 1.55, 0.15, 0.2, 2.0);
+    for (name, h) in [("hair brown", brown), ("hair blond rough", blond_rough), ("hair clear smooth", clear_smooth)] {
+        for (theta, phi) in [(10.0, 90.0), (60.0, 30.0), (85.0, 250.0)] {
+            v.push(azimuth_case(name, Bsdf::Hair(h), theta, phi));
+        }
+    }
 }
 
 /// Mitsuba's principled defaults with `f` applied.
@@ -368,6 +382,21 @@ fn mean_sample_weight_matches_integrated_eval() {
                 est.se,
                 (est.mean - exact) / est.se
             ));
+        }
+    }
+    report(failures);
+}
+
+/// Without absorption the hair model keeps all energy (its attenuations sum to one and each
+/// lobe is a density): ∫ eval dω = 1 to quadrature precision, from every direction.
+#[test]
+fn hair_without_absorption_conserves_energy() {
+    let mut failures = Vec::new();
+    for c in checked().iter().filter(|c| c.case.name.starts_with("hair clear")) {
+        let total = c.integrals.eval_total;
+        println!("{:45} ∫eval {total:.6}", c.case.name);
+        if (total - 1.0).abs() > 10.0 * QUADRATURE_TOLERANCE {
+            failures.push(format!("{}: ∫ eval dω = {total:.6}, not 1", c.case.name));
         }
     }
     report(failures);

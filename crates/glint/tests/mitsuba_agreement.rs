@@ -292,3 +292,11 @@ fn nonlinear_plastics_pplastic_and_polarizer() {
 fn textured_area_emitters_and_an_emitting_cylinder() {
     check("area-textured");
 }
+
+/// Curves and the hair BSDF: a fur ball of B-spline curves with pigmented hair and the same
+/// curves, smaller, as linear curves with an absorption coefficient and rough scales, under
+/// an environment map and a sphere light.
+#[test]
+fn hair_on_curves() {
+    check("hair");
+}

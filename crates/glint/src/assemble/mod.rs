@@ -14,8 +14,8 @@ pub(crate) use driver::patch_appearance;
 pub use driver::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
 
 use crate::accel::BvhSplit;
-use crate::bsdf::Microfacet;
 use crate::bsdf::PrincipledRates;
+use crate::bsdf::{HairBsdf, Microfacet};
 use crate::camera::Camera;
 use crate::describe::ScalarTexture as DescScalar;
 use crate::describe::{
@@ -206,6 +206,13 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
                 specular_probability,
             }
         }
+        MaterialModel::Hair(h) => MaterialKind::Hair(HairBsdf::new(
+            h.sigma_a,
+            h.eta,
+            h.longitudinal_roughness,
+            h.azimuthal_roughness,
+            h.scale_tilt,
+        )),
     })
 }
 

@@ -229,6 +229,26 @@ fn material(m: &MaterialModel) -> Result<(), String> {
             alpha(&Some(roughness.clone()))?;
         }
         MaterialModel::Diffuse { .. } | MaterialModel::Black | MaterialModel::Null => {}
+        MaterialModel::Hair(h) => {
+            eta_ok(h.eta)?;
+            if !(h.sigma_a.r >= 0.0
+                && h.sigma_a.g >= 0.0
+                && h.sigma_a.b >= 0.0
+                && h.sigma_a.max_component().is_finite())
+            {
+                return Err(format!("hair absorption {:?} must be finite and not negative", h.sigma_a));
+            }
+            for (name, v) in
+                [("longitudinal_roughness", h.longitudinal_roughness), ("azimuthal_roughness", h.azimuthal_roughness)]
+            {
+                if !(0.0..=1.0).contains(&v) {
+                    return Err(format!("hair {name} {v} must be in [0, 1]"));
+                }
+            }
+            if !h.scale_tilt.is_finite() {
+                return Err(format!("hair scale_tilt {} must be finite", h.scale_tilt));
+            }
+        }
         MaterialModel::BumpMap { scale, nested, .. } => {
             if !scale.is_finite() {
                 return Err(format!("bump map scale {scale} must be finite"));

@@ -25,6 +25,7 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 mod fresnel;
+mod hair;
 mod microfacet;
 mod null;
 mod perturbed;
@@ -39,6 +40,7 @@ pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::{Dielectric, RoughDielectric, ThinDielectric};
 pub use diffuse::Diffuse;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
+pub use hair::{HairBsdf, EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
 pub use microfacet::{Microfacet, MicrofacetKind};
 pub use null::{Black, Null};
 pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
@@ -192,4 +194,6 @@ bsdfs! {
     Blend(BlendBsdf),
     /// Mitsuba's `pplastic` as its unpolarized variants render it.
     PPlastic(PPlasticParams),
+    /// Mitsuba's `hair` (Chiang et al. 2016), in a curve's frame (x around, y along).
+    Hair(HairBsdf),
 }

@@ -251,6 +251,19 @@ pub enum MaterialModel {
         eta: f32,
         roughness: Roughness,
     },
+    /// Mitsuba's `hair` (Chiang et al. 2016): `sigma_a` the absorption per fibre radius (from
+    /// the pigments, or Mitsuba's `sigma_a` times `scale`), `eta` interior over exterior,
+    /// the roughnesses in [0, 1] and the scale tilt in degrees.
+    Hair(HairDesc),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HairDesc {
+    pub sigma_a: Rgb,
+    pub eta: f32,
+    pub longitudinal_roughness: f32,
+    pub azimuthal_roughness: f32,
+    pub scale_tilt: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -662,7 +675,7 @@ impl MaterialModel {
             MaterialModel::Conductor { roughness, .. } | MaterialModel::Dielectric { roughness, .. } => {
                 rough(roughness)
             }
-            MaterialModel::Black | MaterialModel::Null => vec![],
+            MaterialModel::Black | MaterialModel::Null | MaterialModel::Hair(_) => vec![],
             MaterialModel::PPlastic { diffuse, roughness, .. } => [vec![diffuse], roughness.textures()].concat(),
             MaterialModel::NormalMap { normals: t, nested }
             | MaterialModel::BumpMap { height: t, nested, .. }
@@ -696,7 +709,7 @@ impl MaterialModel {
             MaterialModel::Conductor { roughness, .. } | MaterialModel::Dielectric { roughness, .. } => {
                 rough(roughness)
             }
-            MaterialModel::Black | MaterialModel::Null => vec![],
+            MaterialModel::Black | MaterialModel::Null | MaterialModel::Hair(_) => vec![],
             MaterialModel::NormalMap { normals: t, nested }
             | MaterialModel::BumpMap { height: t, nested, .. }
             | MaterialModel::Mask { opacity: t, nested } => {

@@ -14,7 +14,7 @@ pub use surface::Perturbation;
 pub use texture::{Bitmap, ScalarTexture, Texture, TexturePoint};
 
 use crate::bsdf::{
-    Black, Bsdf, Conductor, Dielectric, Diffuse, Microfacet, Null, PPlasticParams, Phong, PlasticParams,
+    Black, Bsdf, Conductor, Dielectric, Diffuse, HairBsdf, Microfacet, Null, PPlasticParams, Phong, PlasticParams,
     RoughConductor, RoughDielectric, ThinDielectric,
 };
 use crate::math::Rgb;
@@ -98,6 +98,8 @@ pub enum MaterialKind {
         dist: RoughnessMap,
         specular_probability: f32,
     },
+    /// Mitsuba's `hair`.
+    Hair(HairBsdf),
 }
 
 #[derive(Clone, Debug)]
@@ -165,6 +167,7 @@ impl MaterialKind {
             | MaterialKind::RoughConductor { .. }
             | MaterialKind::Plastic { .. }
             | MaterialKind::PPlastic { .. }
+            | MaterialKind::Hair(_)
             | MaterialKind::Black
             | MaterialKind::NormalMap { .. }
             | MaterialKind::BumpMap { .. }
@@ -186,6 +189,7 @@ impl MaterialKind {
             MaterialKind::Principled(p) => p.base_color.eval(uv),
             MaterialKind::Blend(b) => b.albedo(uv),
             MaterialKind::Black
+            | MaterialKind::Hair(_)
             | MaterialKind::NormalMap { .. }
             | MaterialKind::BumpMap { .. }
             | MaterialKind::Mask { .. } => Rgb::BLACK,
@@ -244,6 +248,7 @@ impl MaterialKind {
                     specular_probability: *specular_probability,
                 })
             }
+            MaterialKind::Hair(h) => Bsdf::Hair(*h),
         }
     }
 }

@@ -30,7 +30,8 @@ impl MaterialKind {
             | MaterialKind::Null
             | MaterialKind::Principled(_)
             | MaterialKind::Blend(_)
-            | MaterialKind::PPlastic { .. } => None,
+            | MaterialKind::PPlastic { .. }
+            | MaterialKind::Hair(_) => None,
         }
     }
 

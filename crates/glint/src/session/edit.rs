@@ -141,7 +141,7 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
             out.push(("eta", Slot::Float(eta)));
             roughness_value_slots(roughness, &mut out);
         }
-        MaterialModel::Black | MaterialModel::Null => {}
+        MaterialModel::Black | MaterialModel::Null | MaterialModel::Hair(_) => {}
         // The wrapped material's parameters, and a mask's constant opacity.
         MaterialModel::NormalMap { nested, .. } => return material_slots(nested),
         MaterialModel::BumpMap { scale, nested, .. } => {

@@ -53,6 +53,7 @@ impl<'a> Reader<'a> {
             "principled" => self.principled(&p)?,
             "blendbsdf" => self.blend(&p)?,
             "pplastic" => self.pplastic(&p)?,
+            "hair" => self.hair(&p)?,
             "polarizer" => self.polarizer(&p)?,
             other => return Err(el.err(format!("bsdf plugin '{other}' is not supported"))),
         };

@@ -5,6 +5,7 @@
 //! an error that names the plugin, the file and the line.
 
 mod bsdfs;
+mod hair;
 mod instances;
 mod media;
 mod polarized;

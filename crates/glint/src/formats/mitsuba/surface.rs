@@ -44,7 +44,8 @@ impl<'a> Reader<'a> {
                     | MaterialModel::Null
                     | MaterialModel::Principled(_)
                     | MaterialModel::Blend(_)
-                    | MaterialModel::PPlastic { .. } => return false,
+                    | MaterialModel::PPlastic { .. }
+                    | MaterialModel::Hair(_) => return false,
                 }
             }
         };
