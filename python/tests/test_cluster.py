@@ -236,8 +236,19 @@ def nodes_that_ran(flags: pathlib.Path) -> set:
 
 
 def test_a_render_across_two_nodes_on_loopback_is_bit_identical(cluster, tmp_path, monkeypatch):
+    # The head's first task waits until a task has run on the second node (at most two
+    # minutes): the tasks are small, and on a busy machine the head could otherwise finish
+    # them all before the second node's worker has started (seen once under load).
     local = glint.render(cornell(48), spp=8, seed=4)
-    monkeypatch.setattr(_worker, "render_block", recording_task(tmp_path))
+
+    def hold(flags, node):
+        if node == "head" and not any(flags.glob("head-held")):
+            (flags / "head-held").touch()
+            deadline = time.monotonic() + 120
+            while not any(flags.glob("ran-second-*")) and time.monotonic() < deadline:
+                time.sleep(0.05)
+
+    monkeypatch.setattr(_worker, "render_block", recording_task(tmp_path, hold))
     ray.init(address=gd._address(cluster.address), logging_level="WARNING")
     try:
         wait_for_cpus(2)
