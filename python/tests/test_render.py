@@ -104,5 +104,14 @@ def test_exr_with_layers(tmp_path):
     r = glint.render(cornell(16), spp=1, aovs=["albedo", "depth"])
     glint.write_image(tmp_path / "x.exr", r.image, r.aovs)
     np.testing.assert_array_equal(glint.read_image(tmp_path / "x.exr"), r.image)
-    with pytest.raises(ValueError, match="exr"):
-        glint.write_image(tmp_path / "x.png", r.image, r.aovs)
+    header = (tmp_path / "x.exr").read_bytes()[:4096]
+    for channel in (b"albedo.B\0", b"depth.Z\0"):
+        assert channel in header, channel
+    # Beside a PFM (or PNG) image each layer is a PNG of its own, as the command line writes.
+    glint.write_image(tmp_path / "y.pfm", r.image, r.aovs)
+    assert sorted(p.name for p in tmp_path.glob("y.*")) == ["y.albedo.png", "y.depth.png", "y.pfm"]
+    np.testing.assert_array_equal(glint.read_image(tmp_path / "y.pfm"), r.image)
+    # A layer no PNG can show: refused before anything is written.
+    with pytest.raises(ValueError, match="mask: 2 channels"):
+        glint.write_image(tmp_path / "z.png", r.image, {"mask": np.zeros((16, 16, 2), np.float32)})
+    assert not list(tmp_path.glob("z.*"))

@@ -104,7 +104,7 @@ pub struct RenderArgs {
     #[arg(long, value_delimiter = ',')]
     pub aov: Vec<Aov>,
     /// Denoise with Intel Open Image Denoise (renders the albedo and normal layers to guide
-    /// it; EXR output keeps the noisy image as the layer `noisy`).
+    /// it; the image as rendered is kept as the layer `noisy`).
     #[arg(long)]
     pub denoise: bool,
     /// Adaptive sampling: pixels whose relative standard error is under the threshold stop.

@@ -71,6 +71,7 @@ pub fn write_image(
             });
         }
         let outputs = Outputs { image, layers: aovs };
+        outputs.check(&path).map_err(PyValueError::new_err)?;
         py.detach(|| outputs.write(&path)).map_err(PyOSError::new_err)
     })
 }

@@ -50,9 +50,19 @@ impl Outputs {
         Ok(Outputs { image: clean, layers })
     }
 
+    /// Whether [`Outputs::write`] can write these to `out`: a known format and, beside a
+    /// PNG or PFM image, layers a PNG can show. Checked before anything is written.
+    pub fn check(&self, out: &Path) -> Result<(), String> {
+        match ImageFormat::from_path(out)? {
+            ImageFormat::Exr => Ok(()),
+            ImageFormat::Png | ImageFormat::Pfm => self.layers.iter().try_for_each(|l| look(l).map(|_| ())),
+        }
+    }
+
     /// Writes the image to `out` (the extension chooses the format) and the layers beside
-    /// it.
+    /// it; nothing is written when [`Outputs::check`] fails.
     pub fn write(&self, out: &Path) -> Result<(), String> {
+        self.check(out)?;
         let image = &self.image;
         match ImageFormat::from_path(out)? {
             ImageFormat::Exr => {
