@@ -133,8 +133,8 @@ def render(
     list of scenes, the frames of an animation, which share the workers).
 
     ``scene``: a scene file or a loaded ``glint.Scene`` (edits included), or a list.
-    ``spp``, ``seed``, ``aovs``: as ``glint.render``. ``out``: image to write (EXR for
-    AOVs); for several frames a list or a pattern with ``{frame}``. ``address``: the Ray
+    ``spp``, ``seed``, ``aovs``: as ``glint.render``. ``out``: image to write (layers
+    as the command line writes them); for several frames a list or a pattern with ``{frame}``. ``address``: the Ray
     cluster (``None``: a local Ray instance, started and stopped here; a Ray already
     initialised in this process is used as it is). ``tile``: tile side in pixels.
     ``passes_per_task``: default about 24 tasks per worker slot. ``progress(done_spp,

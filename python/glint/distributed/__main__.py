@@ -35,7 +35,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--aov", action="append", default=[], metavar="NAME[,NAME...]",
                    help="extra layers: albedo, normal, depth, position, variance, spp, bvh-cost")
     p.add_argument("--denoise", action="store_true",
-                   help="denoise with Intel Open Image Denoise (EXR output keeps the noisy image as the layer noisy)")
+                   help="denoise with Intel Open Image Denoise (the image as rendered is kept as the layer noisy)")
     p.add_argument("--address", help="Ray cluster address (default: start a local Ray instance)")
     p.add_argument("--tile", type=int, default=128, help="tile side in pixels")
     p.add_argument("--passes-per-task", type=int, help="passes per task (default: about 24 tasks per worker)")
