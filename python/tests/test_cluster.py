@@ -231,6 +231,20 @@ def recording_task(flags: pathlib.Path, hold=None):
     return task
 
 
+def head_waits_for(node_name: str):
+    """A ``hold`` for ``recording_task``: the head's first task leaves ``head-held`` and waits
+    (at most two minutes) until a task has run on ``node_name``."""
+
+    def hold(flags, node):
+        if node == "head" and not any(flags.glob("head-held")):
+            (flags / "head-held").touch()
+            deadline = time.monotonic() + 120
+            while not any(flags.glob(f"ran-{node_name}-*")) and time.monotonic() < deadline:
+                time.sleep(0.05)
+
+    return hold
+
+
 def nodes_that_ran(flags: pathlib.Path) -> set:
     return {m.name.split("-")[1] for m in flags.glob("ran-*")}
 
@@ -241,14 +255,7 @@ def test_a_render_across_two_nodes_on_loopback_is_bit_identical(cluster, tmp_pat
     # them all before the second node's worker has started (seen once under load).
     local = glint.render(cornell(48), spp=8, seed=4)
 
-    def hold(flags, node):
-        if node == "head" and not any(flags.glob("head-held")):
-            (flags / "head-held").touch()
-            deadline = time.monotonic() + 120
-            while not any(flags.glob("ran-second-*")) and time.monotonic() < deadline:
-                time.sleep(0.05)
-
-    monkeypatch.setattr(_worker, "render_block", recording_task(tmp_path, hold))
+    monkeypatch.setattr(_worker, "render_block", recording_task(tmp_path, head_waits_for("second")))
     ray.init(address=gd._address(cluster.address), logging_level="WARNING")
     try:
         wait_for_cpus(2)
@@ -361,22 +368,15 @@ def test_a_node_that_joins_mid_render_gets_work(cluster, tmp_path, monkeypatch):
     assert not node_pids(cluster.second)
     local = glint.render(cornell(32), spp=8, seed=6)
 
-    def hold(flags, node):
-        if node == "head" and not any(flags.glob("joined-held")):
-            (flags / "joined-held").touch()
-            deadline = time.monotonic() + 120
-            while not any(flags.glob("ran-joined-*")) and time.monotonic() < deadline:
-                time.sleep(0.05)
-
     started = threading.Event()
 
     def join():
-        while not any(tmp_path.glob("joined-held")):
+        while not any(tmp_path.glob("head-held")):
             time.sleep(0.05)
         cluster.start("joined")
         started.set()
 
-    monkeypatch.setattr(_worker, "render_block", recording_task(tmp_path, hold))
+    monkeypatch.setattr(_worker, "render_block", recording_task(tmp_path, head_waits_for("joined")))
     ray.init(address=gd._address(cluster.address), logging_level="WARNING")
     try:
         wait_for_cpus(1)
