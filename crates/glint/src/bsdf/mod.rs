@@ -25,6 +25,7 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 mod fresnel;
+mod gltf_pbr;
 mod hair;
 mod microfacet;
 mod null;
@@ -40,6 +41,7 @@ pub use conductor::{Conductor, RoughConductor};
 pub use dielectric::{Dielectric, RoughDielectric, ThinDielectric};
 pub use diffuse::Diffuse;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
+pub use gltf_pbr::GltfPbr;
 pub use hair::{HairBsdf, EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
 pub use microfacet::{Microfacet, MicrofacetKind};
 pub use null::{Black, Null};
@@ -196,4 +198,6 @@ bsdfs! {
     PPlastic(PPlasticParams),
     /// Mitsuba's `hair` (Chiang et al. 2016), in a curve's frame (x around, y along).
     Hair(HairBsdf),
+    /// The glTF 2.0 metallic-roughness BRDF with the KHR material extensions.
+    GltfPbr(GltfPbr),
 }
