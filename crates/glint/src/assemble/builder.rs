@@ -277,12 +277,12 @@ impl WorldBuilder {
                 let Some(emitter) = MeshEmitter::of_mesh(triangles, mesh.clone(), flip_normals) else {
                     return Err("an emitting mesh has zero area".into());
                 };
-                self.lights.push(PendingLight::Ready(Light::Mesh {
+                self.lights.push(PendingLight::Ready(Light::mesh(
                     instance,
-                    emitter: Arc::new(emitter),
-                    radiance: e.radiance,
-                    two_sided: e.two_sided,
-                }));
+                    Arc::new(emitter),
+                    e.radiance,
+                    e.two_sided,
+                )));
                 Some(self.lights.len() as u32 - 1)
             }
             None => None,
@@ -326,12 +326,7 @@ impl WorldBuilder {
         let instance = self.instances.len() as u32;
         let light = emission.map(|e| {
             // A sphere emits on the side its normal faces (Mitsuba has no two-sided area light).
-            self.lights.push(PendingLight::Ready(Light::Sphere {
-                instance,
-                sphere,
-                radiance: e.radiance,
-                inward: flip_normals,
-            }));
+            self.lights.push(PendingLight::Ready(Light::sphere(instance, sphere, e.radiance, flip_normals)));
             self.lights.len() as u32 - 1
         });
         self.instances.push(Instance {
@@ -368,12 +363,7 @@ impl WorldBuilder {
         let instance = self.instances.len() as u32;
         // Emits on the side its normal faces, as a sphere.
         let light = emission.map(|e| {
-            self.lights.push(PendingLight::Ready(Light::Cylinder {
-                instance,
-                cylinder,
-                radiance: e.radiance,
-                inward: flip_normals,
-            }));
+            self.lights.push(PendingLight::Ready(Light::cylinder(instance, cylinder, e.radiance, flip_normals)));
             self.lights.len() as u32 - 1
         });
         self.instances.push(Instance {

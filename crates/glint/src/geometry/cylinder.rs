@@ -99,6 +99,16 @@ impl Cylinder {
         self.point_at(local)
     }
 
+    /// The uv of a point on the tube (as `point` would give it).
+    pub fn uv_at(&self, q: Vec3) -> [f32; 2] {
+        let local = self.to_world.inv_point(q);
+        let mut phi = local.y.atan2(local.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        [phi / (2.0 * PI), local.z.clamp(0.0, 1.0)]
+    }
+
     /// The point at local coordinates `(cos φ, sin φ, z)`.
     fn point_at(&self, local: Vec3) -> CylinderPoint {
         let dp_du = self.to_world.vector(vec3(-local.y, local.x, 0.0));

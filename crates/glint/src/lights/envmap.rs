@@ -3,7 +3,7 @@
 use super::LightSample;
 use crate::materials::Bitmap;
 use crate::math::{Rgb, Transform, Vec3, PI};
-use crate::sampling::Distribution1d;
+use crate::sampling::Distribution2d;
 
 #[derive(Clone, Debug)]
 pub struct EnvMap {
@@ -12,25 +12,19 @@ pub struct EnvMap {
     /// Environment-to-world rotation.
     pub to_world: Transform,
     pub scene_radius: f32,
-    rows: Distribution1d,
-    cols: Vec<Distribution1d>,
+    texels: Distribution2d,
 }
 
 impl EnvMap {
     pub fn new(image: Bitmap, scale: f32, to_world: Transform, scene_radius: f32) -> Result<EnvMap, String> {
         let (w, h) = (image.width, image.height);
-        let mut cols = Vec::with_capacity(h);
-        let mut row_weights = Vec::with_capacity(h);
+        let mut weights = Vec::with_capacity(w * h);
         for y in 0..h {
             let sin_t = (PI * (y as f32 + 0.5) / h as f32).sin();
-            let weights: Vec<f32> = (0..w).map(|x| image.pixels[y * w + x].luminance().max(0.0) * sin_t).collect();
-            let sum: f32 = weights.iter().sum();
-            row_weights.push(sum);
-            // A black row is never chosen, but keep a valid distribution for it.
-            cols.push(Distribution1d::new(&weights).unwrap_or_else(|| Distribution1d::new(&vec![1.0; w]).unwrap()));
+            weights.extend((0..w).map(|x| image.pixels[y * w + x].luminance().max(0.0) * sin_t));
         }
-        let rows = Distribution1d::new(&row_weights).ok_or("the environment map is black everywhere")?;
-        Ok(EnvMap { image, scale, to_world, scene_radius, rows, cols })
+        let texels = Distribution2d::new(&weights, w, h).ok_or("the environment map is black everywhere")?;
+        Ok(EnvMap { image, scale, to_world, scene_radius, texels })
     }
 
     pub fn mean_luminance(&self) -> f32 {
@@ -88,21 +82,20 @@ impl EnvMap {
         if sin_t <= 0.0 {
             return 0.0;
         }
-        let pmf = self.rows.pmf(y) * self.cols[y].pmf(x);
+        let pmf = self.texels.pmf(x, y);
         // Pixel density in uv is pmf * w * h; Jacobian uv -> solid angle is 2π² sin θ.
         pmf * (w * h) as f32 / (2.0 * PI * PI * sin_t)
     }
 
     pub fn sample(&self, u: [f32; 2]) -> Option<LightSample> {
         let (w, h) = (self.image.width, self.image.height);
-        let row = self.rows.sample(u[1]);
-        let col = self.cols[row.index].sample(u[0]);
-        let uv = [(col.index as f32 + col.remapped) / w as f32, (row.index as f32 + row.remapped) / h as f32];
+        let s = self.texels.sample(u);
+        let uv = [(s.x as f32 + s.remapped[0]) / w as f32, (s.y as f32 + s.remapped[1]) / h as f32];
         let (wi, sin_t) = self.dir_from_uv(uv);
         if sin_t <= 0.0 {
             return None;
         }
-        let pdf = row.pmf * col.pmf * (w * h) as f32 / (2.0 * PI * PI * sin_t);
+        let pdf = s.pmf * (w * h) as f32 / (2.0 * PI * PI * sin_t);
         if pdf <= 0.0 {
             return None;
         }

@@ -6,11 +6,14 @@
 //! - `power()`: an estimate of emitted flux, for choosing among lights.
 //!
 //! Area lights emit a radiance texture read at the surface's uv (Mitsuba's `area` emitter
-//! with a textured `radiance`). Their points are sampled by the shape's geometry alone (by
-//! solid angle where the shape allows it, by area otherwise) and the texture is read at the
-//! point sampled, so light sampling and rays that hit the light weigh the same radiance;
-//! Mitsuba samples a spatially varying radiance by the texture instead, which converges to
-//! the same image. Their power (for light selection) uses the texture's mean.
+//! with a textured `radiance`). A bitmap radiance on a sphere, a cylinder or a rectangle
+//! whose uvs span it once is sampled by its texels (`texel`: the filtered luminance times
+//! the area Jacobian, mapped onto the surface), as Mitsuba samples it; other textures and
+//! other meshes (disks, general meshes with uvs) are sampled by the shape's geometry alone
+//! (by solid angle where the shape allows it, by area otherwise) and the texture is read at
+//! the point sampled. Either way `pdf_li` gives the density the sampler used, so light
+//! sampling and rays that hit the light are weighed alike. Their power (for light
+//! selection) uses the texture's mean.
 //!
 //! Delta lights (point, spot, directional) have a density of 1 by convention and are never
 //! hit by BSDF-sampled rays.
@@ -19,12 +22,15 @@ mod envmap;
 mod projected;
 mod rectangle;
 mod sphere;
+mod texel;
 pub use crate::describe::LightSelection;
 pub use envmap::EnvMap;
 pub use projected::{ProjectedKind, ProjectedLight};
 pub use rectangle::Rectangle;
+pub use texel::{RectangleImportance, TexelImportance, UvJacobian, UvRectangle};
 
 use rectangle::SphericalRectangle;
+use texel::SPHERE_UV_JACOBIAN;
 
 use crate::geometry::{Cylinder, Sphere, TriangleMesh};
 use crate::materials::{Texture, TexturePoint};
@@ -148,6 +154,40 @@ impl MeshEmitter {
         (best.0, best.1)
     }
 
+    /// The uv map of a rectangle emitter whose uvs are affine over it and span the unit
+    /// square once, for importance-sampling a bitmap on it; `None` for other meshes.
+    pub fn uv_rectangle(&self) -> Option<UvRectangle> {
+        let r = self.rectangle.as_ref()?;
+        let uvs = |tri: usize| [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]].map(|e| self.texture_point(tri, e).uv);
+        // Triangle 0's affine map from uv to space: q = a + E M⁻¹ (uv - uv_a).
+        let [a, b, c] = self.triangles[0];
+        let [ta, tb, tc] = uvs(0);
+        let (m00, m01, m10, m11) = (tb[0] - ta[0], tc[0] - ta[0], tb[1] - ta[1], tc[1] - ta[1]);
+        let det = m00 * m11 - m01 * m10;
+        if !(det.abs() > 1e-12) {
+            return None;
+        }
+        let q = |t: [f32; 2]| {
+            let (x, y) = (t[0] - ta[0], t[1] - ta[1]);
+            let (b1, b2) = ((m11 * x - m01 * y) / det, (m00 * y - m10 * x) / det);
+            a + (b - a) * b1 + (c - a) * b2
+        };
+        let origin = q([0.0, 0.0]);
+        let map = UvRectangle { origin, du: q([1.0, 0.0]) - origin, dv: q([0.0, 1.0]) - origin, area: r.area() };
+        let tol = 1e-4 * (r.ex.length() + r.ey.length());
+        let close = |p: Vec3, q: Vec3| (p - q).length() <= tol;
+        // Both triangles follow the same map, ...
+        let same_map = (0..2).all(|tri| {
+            let t = uvs(tri);
+            (0..3).all(|k| close(q(t[k]), self.triangles[tri][k]))
+        });
+        // ... which takes the unit square onto the rectangle.
+        let corners = [r.corner, r.corner + r.ex, r.corner + r.ey, r.corner + r.ex + r.ey];
+        let square = [map.origin, map.origin + map.du, map.origin + map.dv, map.origin + map.du + map.dv];
+        let onto = square.iter().all(|&p| corners.iter().any(|&c| close(p, c)));
+        (same_map && onto).then_some(map)
+    }
+
     /// Whether light samples seen from `p` are drawn by solid angle (otherwise by area).
     pub fn samples_by_solid_angle(&self, p: Vec3) -> bool {
         self.spherical_rectangle(p).is_some()
@@ -188,6 +228,8 @@ pub enum Light {
         emitter: Arc<MeshEmitter>,
         radiance: Texture,
         two_sided: bool,
+        /// A bitmap radiance on a rectangle, sampled by its texels (see `texel`).
+        importance: Option<Arc<RectangleImportance>>,
     },
     /// Area light on a sphere; sampled by the solid angle it subtends.
     Sphere {
@@ -196,6 +238,8 @@ pub enum Light {
         radiance: Texture,
         /// Normals flipped: the sphere emits into its inside only (otherwise outside only).
         inward: bool,
+        /// A bitmap radiance, sampled by its texels over the whole sphere.
+        importance: Option<Arc<TexelImportance>>,
     },
     /// Area light on an open cylinder; sampled uniformly by area (as Mitsuba samples it).
     Cylinder {
@@ -204,6 +248,8 @@ pub enum Light {
         radiance: Texture,
         /// Normals flipped: the tube emits towards its axis only (otherwise outward only).
         inward: bool,
+        /// A bitmap radiance, sampled by its texels.
+        importance: Option<Arc<TexelImportance>>,
     },
     /// Uniform radiance from every direction.
     Constant {
@@ -217,6 +263,28 @@ pub enum Light {
 }
 
 impl Light {
+    /// An area light on a mesh; a bitmap radiance on a rectangle whose uvs span it once is
+    /// importance-sampled by its texels.
+    pub fn mesh(instance: u32, emitter: Arc<MeshEmitter>, radiance: Texture, two_sided: bool) -> Light {
+        let importance = emitter.uv_rectangle().and_then(|map| {
+            let texels = TexelImportance::new(&radiance, UvJacobian::Uniform)?;
+            Some(Arc::new(RectangleImportance { texels, map }))
+        });
+        Light::Mesh { instance, emitter, radiance, two_sided, importance }
+    }
+
+    /// An area light on a sphere; a bitmap radiance is importance-sampled by its texels.
+    pub fn sphere(instance: u32, sphere: Sphere, radiance: Texture, inward: bool) -> Light {
+        let importance = TexelImportance::new(&radiance, UvJacobian::SinPiV).map(Arc::new);
+        Light::Sphere { instance, sphere, radiance, inward, importance }
+    }
+
+    /// An area light on a cylinder; a bitmap radiance is importance-sampled by its texels.
+    pub fn cylinder(instance: u32, cylinder: Cylinder, radiance: Texture, inward: bool) -> Light {
+        let importance = TexelImportance::new(&radiance, UvJacobian::Uniform).map(Arc::new);
+        Light::Cylinder { instance, cylinder, radiance, inward, importance }
+    }
+
     pub fn is_delta(&self) -> bool {
         matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } | Light::Projected(_))
     }
@@ -291,7 +359,13 @@ impl Light {
             Light::Directional { direction, irradiance, .. } => {
                 Some(LightSample { wi: -*direction, radiance: *irradiance, pdf: 1.0, dist: f32::INFINITY, delta: true })
             }
-            Light::Mesh { emitter, radiance, two_sided, .. } => {
+            Light::Mesh { emitter, radiance, two_sided, importance: Some(imp), .. } => {
+                let (uv, pdf_uv) = imp.texels.sample(u)?;
+                let n = emitter.rectangle.as_ref()?.normal;
+                let le = radiance_at(radiance, || TexturePoint::uv(uv));
+                area_sample(p, imp.map.point(uv), n, *two_sided, pdf_uv / imp.map.area, le)
+            }
+            Light::Mesh { emitter, radiance, two_sided, importance: None, .. } => {
                 let by_solid_angle = emitter.spherical_rectangle(p);
                 let (q, n, at) = match &by_solid_angle {
                     Some(sr) => (sr.sample(u), emitter.rectangle.as_ref()?.normal, None),
@@ -333,7 +407,20 @@ impl Light {
                 });
                 Some(LightSample { wi, radiance, pdf, dist, delta: false })
             }
-            Light::Sphere { sphere, radiance, inward, .. } => {
+            Light::Sphere { sphere, radiance, inward, importance: Some(imp), .. } => {
+                let (uv, pdf_uv) = imp.sample(u)?;
+                let (st, ct) = (PI * uv[1]).sin_cos();
+                let (sp, cp) = (2.0 * PI * uv[0]).sin_cos();
+                let dir = sphere.axes[0] * (st * cp) + sphere.axes[1] * (st * sp) + sphere.axes[2] * ct;
+                let n = if *inward { -dir } else { dir };
+                let jacobian = SPHERE_UV_JACOBIAN * sphere.radius * sphere.radius * st;
+                if !(jacobian > 0.0) {
+                    return None;
+                }
+                let le = radiance_at(radiance, || TexturePoint::uv(uv));
+                area_sample(p, sphere.center + dir * sphere.radius, n, false, pdf_uv / jacobian, le)
+            }
+            Light::Sphere { sphere, radiance, inward, importance: None, .. } => {
                 let mut ls = sphere::sample(sphere, Rgb::WHITE, *inward, p, u)?;
                 ls.radiance = radiance_at(radiance, || {
                     let n = (p + ls.wi * ls.dist - sphere.center).normalize();
@@ -341,7 +428,14 @@ impl Light {
                 });
                 Some(ls)
             }
-            Light::Cylinder { cylinder, radiance, inward, .. } => {
+            Light::Cylinder { cylinder, radiance, inward, importance: Some(imp), .. } => {
+                let (uv, pdf_uv) = imp.sample(u)?;
+                let q = cylinder.sample(uv);
+                let n = if *inward { -q.n } else { q.n };
+                let le = radiance_at(radiance, || TexturePoint::uv(uv));
+                area_sample(p, q.p, n, false, pdf_uv / cylinder.area(), le)
+            }
+            Light::Cylinder { cylinder, radiance, inward, importance: None, .. } => {
                 let q = cylinder.sample(u);
                 let n = if *inward { -q.n } else { q.n };
                 let d = q.p - p;
@@ -378,7 +472,22 @@ impl Light {
     /// area light, or direction `wi` for an infinite light.
     pub fn pdf_li(&self, p: Vec3, wi: Vec3, q: Vec3, n: Vec3) -> f32 {
         match self {
-            Light::Mesh { emitter, .. } => {
+            Light::Mesh { importance: Some(imp), .. } => {
+                solid_angle_pdf(p, wi, q, n, imp.texels.pdf(imp.map.uv(q)) / imp.map.area)
+            }
+            Light::Sphere { sphere, importance: Some(imp), .. } => {
+                let dir = (q - sphere.center).normalize();
+                let st = (1.0 - sphere.to_local(dir).z.powi(2)).max(0.0).sqrt();
+                let jacobian = SPHERE_UV_JACOBIAN * sphere.radius * sphere.radius * st;
+                if !(jacobian > 0.0) {
+                    return 0.0;
+                }
+                solid_angle_pdf(p, wi, q, n, imp.pdf(sphere.uv(dir)) / jacobian)
+            }
+            Light::Cylinder { cylinder, importance: Some(imp), .. } => {
+                solid_angle_pdf(p, wi, q, n, imp.pdf(cylinder.uv_at(q)) / cylinder.area())
+            }
+            Light::Mesh { emitter, importance: None, .. } => {
                 if let Some(sr) = emitter.spherical_rectangle(p) {
                     return sr.pdf();
                 }
@@ -389,8 +498,8 @@ impl Light {
                 }
                 dist2 / (cos_l * emitter.total_area)
             }
-            Light::Sphere { sphere, .. } => sphere::pdf(sphere, p, q, n, wi),
-            Light::Cylinder { cylinder, .. } => {
+            Light::Sphere { sphere, importance: None, .. } => sphere::pdf(sphere, p, q, n, wi),
+            Light::Cylinder { cylinder, importance: None, .. } => {
                 let cos_l = n.dot(wi).abs();
                 if cos_l == 0.0 {
                     return 0.0;
@@ -439,6 +548,34 @@ impl Light {
     }
 }
 
+/// A light sample at `q` on an area light (normal `n` on its emitting side; either side when
+/// `two_sided`), drawn with density `pdf_area` per unit area, seen from `p`.
+fn area_sample(p: Vec3, q: Vec3, n: Vec3, two_sided: bool, pdf_area: f32, radiance: Rgb) -> Option<LightSample> {
+    let d = q - p;
+    let dist2 = d.length_squared();
+    if !(dist2 > 0.0) {
+        return None;
+    }
+    let dist = dist2.sqrt();
+    let wi = d / dist;
+    let cos_l = -n.dot(wi);
+    if !(cos_l > 0.0 || (two_sided && cos_l < 0.0)) {
+        return None;
+    }
+    let pdf = pdf_area * dist2 / cos_l.abs();
+    Some(LightSample { wi, radiance, pdf, dist, delta: false })
+}
+
+/// The solid-angle density at `p` of direction `wi` reaching `q` (normal `n`), from a
+/// density per unit area.
+fn solid_angle_pdf(p: Vec3, wi: Vec3, q: Vec3, n: Vec3, pdf_area: f32) -> f32 {
+    let cos_l = n.dot(wi).abs();
+    if !(cos_l > 0.0) {
+        return 0.0;
+    }
+    pdf_area * (q - p).length_squared() / cos_l
+}
+
 fn spot_falloff(cos_t: f32, cutoff: f32, beam: f32) -> f32 {
     if cos_t <= cutoff.cos() {
         return 0.0;
@@ -466,7 +603,7 @@ mod tests {
     #[test]
     fn sphere_lights_are_sampled_only_from_the_side_they_light() {
         let sphere = Sphere::new(Vec3::ZERO, 1.0);
-        let light = |inward| Light::Sphere { instance: 0, sphere, radiance: Texture::Constant(Rgb::WHITE), inward };
+        let light = |inward| Light::sphere(0, sphere, Texture::Constant(Rgb::WHITE), inward);
         let (outside, inside) = (vec3(0.0, 0.0, 3.0), vec3(0.2, 0.1, 0.0));
         for u in [[0.1, 0.2], [0.5, 0.5], [0.9, 0.7]] {
             assert!(light(false).sample_li(outside, u).is_some());
@@ -481,12 +618,7 @@ mod tests {
         let (a, b, c, d) = (vec3(-1.0, -0.1, 2.8), vec3(1.0, -0.1, 2.8), vec3(1.0, 0.1, 2.8), vec3(-1.0, 0.1, 2.8));
         let emitter = MeshEmitter::new(vec![[a, c, b], [a, d, c]]).unwrap();
         assert!(emitter.rectangle.is_some());
-        Light::Mesh {
-            instance: 0,
-            emitter: Arc::new(emitter),
-            radiance: Texture::Constant(Rgb::WHITE),
-            two_sided: false,
-        }
+        Light::mesh(0, Arc::new(emitter), Texture::Constant(Rgb::WHITE), false)
     }
 
     #[test]

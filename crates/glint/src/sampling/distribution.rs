@@ -61,6 +61,61 @@ impl Distribution1d {
     }
 }
 
+/// A discrete distribution over the cells of a `width` × `height` grid, proportional to
+/// non-negative weights: a row by the rows' sums (with `u[1]`), then a column within it
+/// (with `u[0]`). Shared by the environment map and textured area lights.
+#[derive(Clone, Debug)]
+pub struct Distribution2d {
+    rows: Distribution1d,
+    cols: Vec<Distribution1d>,
+}
+
+/// The cell chosen, its probability, and the random numbers rescaled within it.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample2d {
+    pub x: usize,
+    pub y: usize,
+    pub pmf: f32,
+    pub remapped: [f32; 2],
+}
+
+impl Distribution2d {
+    /// `weights` row by row (`weights[y * width + x]`); `None` when they are all zero.
+    pub fn new(weights: &[f32], width: usize, height: usize) -> Option<Distribution2d> {
+        if width == 0 || weights.len() != width * height {
+            return None;
+        }
+        let mut cols = Vec::with_capacity(height);
+        let mut row_weights = Vec::with_capacity(height);
+        for row in weights.chunks(width) {
+            row_weights.push(row.iter().map(|w| w.max(0.0)).sum::<f32>());
+            // A black row is never chosen, but keep a valid distribution for it.
+            cols.push(Distribution1d::new(row).unwrap_or_else(|| Distribution1d::new(&vec![1.0; width]).unwrap()));
+        }
+        let rows = Distribution1d::new(&row_weights)?;
+        Some(Distribution2d { rows, cols })
+    }
+
+    pub fn width(&self) -> usize {
+        self.cols[0].len()
+    }
+
+    pub fn height(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The probability of cell (x, y).
+    pub fn pmf(&self, x: usize, y: usize) -> f32 {
+        self.rows.pmf(y) * self.cols[y].pmf(x)
+    }
+
+    pub fn sample(&self, u: [f32; 2]) -> Sample2d {
+        let row = self.rows.sample(u[1]);
+        let col = self.cols[row.index].sample(u[0]);
+        Sample2d { x: col.index, y: row.index, pmf: row.pmf * col.pmf, remapped: [col.remapped, row.remapped] }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -79,5 +134,29 @@ mod tests {
     fn all_zero_is_none() {
         assert!(Distribution1d::new(&[0.0, 0.0]).is_none());
         assert!(Distribution1d::new(&[]).is_none());
+    }
+
+    #[test]
+    fn grid_cells_are_chosen_by_weight_and_pmfs_sum_to_one() {
+        let w = [1.0, 0.0, 3.0, 0.0, 0.0, 0.0, 2.0, 2.0, 0.0];
+        let d = Distribution2d::new(&w, 3, 3).unwrap();
+        let total: f32 = (0..3).flat_map(|y| (0..3).map(move |x| (x, y))).map(|(x, y)| d.pmf(x, y)).sum();
+        assert!((total - 1.0).abs() < 1e-6);
+        let n = 400;
+        let mut counts = [0u32; 9];
+        for i in 0..n {
+            for j in 0..n {
+                let s = d.sample([(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32]);
+                assert_eq!(s.pmf, d.pmf(s.x, s.y));
+                counts[s.y * 3 + s.x] += 1;
+            }
+        }
+        // A stratified grid of u lands in each cell in proportion to its weight (to one row
+        // or column of strata).
+        for (k, &c) in counts.iter().enumerate() {
+            let expected = w[k] / 8.0 * (n * n) as f32;
+            assert!((c as f32 - expected).abs() <= 2.0 * n as f32, "cell {k}: {c} vs {expected}");
+        }
+        assert!(Distribution2d::new(&[0.0; 4], 2, 2).is_none());
     }
 }

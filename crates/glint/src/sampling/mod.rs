@@ -8,7 +8,7 @@ pub mod warp;
 
 pub use crate::describe::PixelFilter;
 pub use crate::describe::SamplerKind;
-pub use distribution::{DiscreteSample, Distribution1d};
+pub use distribution::{DiscreteSample, Distribution1d, Distribution2d, Sample2d};
 pub use rng::{mix64, Rng};
 pub use sampler::Sampler;
 
