@@ -23,11 +23,13 @@ mod projected;
 mod rectangle;
 mod sphere;
 mod texel;
+mod tree;
 pub use crate::describe::LightSelection;
 pub use envmap::EnvMap;
 pub use projected::{ProjectedKind, ProjectedLight};
 pub use rectangle::Rectangle;
 pub use texel::{RectangleImportance, TexelImportance, UvJacobian, UvRectangle};
+pub use tree::{LightTree, TreeSample};
 
 use rectangle::SphericalRectangle;
 use texel::SPHERE_UV_JACOBIAN;
