@@ -62,6 +62,12 @@ fn check(name: &str) {
 }
 
 fn check_with_mean_tolerance(name: &str, tolerance: f64) {
+    check_against(name, tolerance, 1.3);
+}
+
+/// Criterion (a) with `tolerance`, and (b) with the relative MSE at most `error_ratio` times
+/// Mitsuba's.
+fn check_against(name: &str, tolerance: f64, error_ratio: f64) {
     let entry = reference_entry(name);
     let mitsuba_rel_mse = entry["mitsuba_rel_mse"].as_f64().unwrap();
     let image = render_at(name, entry["test_spp"].as_u64().unwrap());
@@ -71,7 +77,10 @@ fn check_with_mean_tolerance(name: &str, tolerance: f64) {
     let err = rel_mse(&image, &reference);
     eprintln!("{name}: means {ours:?} vs {theirs:?}; relMSE {err:.3e} vs Mitsuba's {mitsuba_rel_mse:.3e}");
     assert_means_agree(name, ours, theirs, tolerance);
-    assert!(err <= 1.3 * mitsuba_rel_mse, "{name}: relative MSE {err:.3e} > 1.3 x Mitsuba's {mitsuba_rel_mse:.3e}");
+    assert!(
+        err <= error_ratio * mitsuba_rel_mse,
+        "{name}: relative MSE {err:.3e} > {error_ratio} x Mitsuba's {mitsuba_rel_mse:.3e}"
+    );
 }
 
 #[test]
@@ -291,6 +300,22 @@ fn nonlinear_plastics_pplastic_and_polarizer() {
 #[test]
 fn textured_area_emitters_and_an_emitting_cylinder() {
     check("area-textured");
+}
+
+/// A rectangle light with a high-contrast HDR bitmap, an orthographic camera, a blend BSDF and
+/// a cylinder. glint samples the light by its bilinearly filtered texels (Mitsuba by its
+/// texels, piecewise constant), so its error must be no larger than Mitsuba's (issue 30's
+/// target: at most 1.0x; it was 1.83x when the light was sampled by area).
+#[test]
+fn rectangle_light_with_an_hdr_bitmap() {
+    check_against("area-hdr-panel", 0.01, 1.0);
+}
+
+/// A large light whose bitmap is a few bright texels on a dim ground (46.8x Mitsuba's error
+/// when sampled by area), at most 1.0x Mitsuba's error.
+#[test]
+fn large_light_of_a_few_bright_texels() {
+    check_against("area-bright-texels", 0.01, 1.0);
 }
 
 /// Curves and the hair BSDF: a fur ball of B-spline curves with pigmented hair and the same

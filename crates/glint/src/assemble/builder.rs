@@ -528,6 +528,7 @@ impl WorldBuilder {
             camera,
             bounds,
             light_distribution: None,
+            light_tree: None,
             light_selection: selection,
             bvh_split: self.split,
             bvh_build_seconds: 0.0,

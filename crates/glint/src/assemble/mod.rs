@@ -259,8 +259,9 @@ fn add_light(b: &mut WorldBuilder, l: &LightKind, textures: &mut TextureCache) -
         LightKind::Point { position, intensity } => {
             b.add_light(Light::Point { position: *position, intensity: *intensity })
         }
-        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees } => {
+        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees, falloff } => {
             b.add_light(Light::Spot {
+                gltf_falloff: *falloff == crate::describe::SpotFalloff::Gltf,
                 position: *position,
                 frame: Frame::from_normal(direction.normalize()),
                 intensity: *intensity,

@@ -358,7 +358,7 @@ fn light(l: &LightKind) -> Result<(), String> {
             vector(*position, "position")?;
             color(*intensity, "intensity")
         }
-        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees } => {
+        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees, .. } => {
             vector(*position, "position")?;
             direction_of(*direction, "spot direction (its target equals its position?)")?;
             color(*intensity, "intensity")?;

@@ -506,6 +506,9 @@ pub enum LightKind {
         intensity: Rgb,
         cutoff_degrees: f32,
         beam_degrees: f32,
+        /// How the intensity falls between the cones (Mitsuba's unless a glTF file says).
+        #[serde(default, skip_serializing_if = "SpotFalloff::is_linear")]
+        falloff: SpotFalloff,
     },
     /// `direction` is where the light travels.
     Directional {
@@ -540,6 +543,23 @@ pub enum LightKind {
         fov_degrees: f32,
         fov_axis: FovAxis,
     },
+}
+
+/// How a spot light's intensity falls from the beam's cone to the cutoff's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SpotFalloff {
+    /// Linear in the angle (Mitsuba's `spot`).
+    #[default]
+    Linear,
+    /// `KHR_lights_punctual`'s: linear in the cosine between the cones, then squared.
+    Gltf,
+}
+
+impl SpotFalloff {
+    pub fn is_linear(&self) -> bool {
+        *self == SpotFalloff::Linear
+    }
 }
 
 impl SceneDesc {

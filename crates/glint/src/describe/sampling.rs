@@ -45,6 +45,9 @@ pub enum LightSelection {
     /// of the choices are made so, the other half uniformly (see `World::POWER_SHARE`).
     #[default]
     Power,
+    /// By a light BVH, from each shading point, in proportion to a bound of what each group
+    /// of lights sends there (`lights::LightTree`).
+    Tree,
 }
 
 impl std::str::FromStr for LightSelection {
@@ -54,7 +57,8 @@ impl std::str::FromStr for LightSelection {
             "uniform" => Ok(LightSelection::Uniform),
             "area" => Ok(LightSelection::Area),
             "power" => Ok(LightSelection::Power),
-            _ => Err(format!("unknown light selection '{s}' (expected uniform, area or power)")),
+            "tree" => Ok(LightSelection::Tree),
+            _ => Err(format!("unknown light selection '{s}' (expected uniform, area, power or tree)")),
         }
     }
 }

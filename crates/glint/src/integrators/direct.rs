@@ -49,33 +49,33 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
     let (n_e, n_b) = (s.emitter_samples as f32, s.bsdf_samples as f32);
 
     // Light sampling (not for BSDFs that only reflect in delta directions).
-    if !bsdf.is_delta() {
-        if let Some(dist) = &scene.light_distribution {
-            for _ in 0..s.emitter_samples {
-                // The light and the point on it from one 2D point (see path.rs).
-                let u = rng.next_2d();
-                let pick = dist.sample(u[0]);
-                let light = &scene.lights[pick.index];
-                let Some(ls) = light.sample_li(si.p, [pick.remapped, u[1]]) else {
-                    continue;
-                };
-                if !(ls.pdf > 0.0) || ls.radiance.is_black() {
-                    continue;
-                }
-                let wi = frame.to_local(ls.wi);
-                let f = bsdf.eval(wo, wi);
-                if f.is_black() {
-                    continue;
-                }
-                c.shadow_rays += 1;
-                let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
-                if !(visible > 0.0) {
-                    continue;
-                }
-                let light_pdf = pick.pmf * ls.pdf;
-                let w = if ls.delta { 1.0 } else { power_heuristic(n_e * light_pdf, n_b * bsdf.pdf(wo, wi)) };
-                l += f * ls.radiance * (w * visible / (n_e * light_pdf));
+    if !bsdf.is_delta() && scene.can_choose_lights() {
+        for _ in 0..s.emitter_samples {
+            // The light and the point on it from one 2D point (see path.rs).
+            let u = rng.next_2d();
+            let Some((index, pick_pmf, remapped)) = scene.choose_light(si.p, u[0]) else {
+                continue;
+            };
+            let light = &scene.lights[index];
+            let Some(ls) = light.sample_li(si.p, [remapped, u[1]]) else {
+                continue;
+            };
+            if !(ls.pdf > 0.0) || ls.radiance.is_black() {
+                continue;
             }
+            let wi = frame.to_local(ls.wi);
+            let f = bsdf.eval(wo, wi);
+            if f.is_black() {
+                continue;
+            }
+            c.shadow_rays += 1;
+            let visible = transmittance(scene, &shadow_ray(&si, ls.wi, ls.dist), c);
+            if !(visible > 0.0) {
+                continue;
+            }
+            let light_pdf = pick_pmf * ls.pdf;
+            let w = if ls.delta { 1.0 } else { power_heuristic(n_e * light_pdf, n_b * bsdf.pdf(wo, wi)) };
+            l += f * ls.radiance * (w * visible / (n_e * light_pdf));
         }
     }
 
@@ -107,7 +107,7 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                         let light = &scene.lights[li_idx as usize];
                         let le = scene.emitted(&sj, ray.dir);
                         if !le.is_black() {
-                            let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, sj.p, sj.ng);
+                            let light_pdf = scene.light_pmf_at(si.p, li_idx) * light.pdf_li(si.p, ray.dir, sj.p, sj.ng);
                             l += weight(light_pdf) * le * through;
                         }
                     }
@@ -124,7 +124,8 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                         if le.is_black() {
                             continue;
                         }
-                        let light_pdf = scene.light_pmf(li_idx) * light.pdf_li(si.p, ray.dir, ray.origin, ray.dir);
+                        let light_pdf =
+                            scene.light_pmf_at(si.p, li_idx) * light.pdf_li(si.p, ray.dir, ray.origin, ray.dir);
                         l += weight(light_pdf) * le * through;
                     }
                     break;

@@ -25,14 +25,16 @@ pub(crate) struct PrevEvent {
 /// share of the samples); `None` without lights, or when the sample carries nothing. The
 /// second value is the probability of choosing the light.
 pub(crate) fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
-    let dist = scene.light_distribution.as_ref()?;
+    if !scene.can_choose_lights() {
+        return None;
+    }
     let u = rng.next_2d();
-    let pick = dist.sample(u[0]);
-    let ls = scene.lights[pick.index].sample_li(p, [pick.remapped, u[1]])?;
+    let (index, pmf, remapped) = scene.choose_light(p, u[0])?;
+    let ls = scene.lights[index].sample_li(p, [remapped, u[1]])?;
     if !(ls.pdf > 0.0) || ls.radiance.is_black() {
         return None;
     }
-    Some((ls, pick.pmf))
+    Some((ls, pmf))
 }
 
 /// MIS weight of an emitter reached by a sampled direction (`light_pdf`, the density light
@@ -65,7 +67,7 @@ pub(crate) fn add_environment(
             continue;
         }
         let w = emitter_weight(strategy, prev, || {
-            scene.light_pmf(li_idx) * light.pdf_li(prev.p, ray.dir, ray.origin, ray.dir)
+            scene.light_pmf_at(prev.p, li_idx) * light.pdf_li(prev.p, ray.dir, ray.origin, ray.dir)
         });
         *l += throughput * le * w;
     }
@@ -87,7 +89,9 @@ pub(crate) fn add_emitted(
     let light = &scene.lights[li_idx as usize];
     let le = scene.emitted(si, ray.dir);
     if !le.is_black() {
-        let w = emitter_weight(strategy, prev, || scene.light_pmf(li_idx) * light.pdf_li(prev.p, ray.dir, si.p, si.ng));
+        let w = emitter_weight(strategy, prev, || {
+            scene.light_pmf_at(prev.p, li_idx) * light.pdf_li(prev.p, ray.dir, si.p, si.ng)
+        });
         *l += throughput * le * w;
     }
 }

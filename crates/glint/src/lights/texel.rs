@@ -55,10 +55,10 @@ impl TexelImportance {
         let row_weight: Vec<f32> = (0..height).map(|j| row_weight(jacobian, j, height)).collect();
         let mut weights = Vec::with_capacity(width * height);
         let mut total = 0.0f64;
-        for j in 0..height {
+        for (j, rw) in row_weight.iter().enumerate() {
             for i in 0..width {
                 let [a, b, c, d] = corners(&lum, width, height, i, j);
-                let w = 0.25 * (a + b + c + d) * row_weight[j];
+                let w = 0.25 * (a + b + c + d) * rw;
                 total += w as f64;
                 weights.push(w);
             }

@@ -10,7 +10,7 @@
 use crate::accel::{prefetch, BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{CurveHit, Curves, Cylinder, SdfGrid, Sphere, TriangleMesh};
-use crate::lights::{Light, LightSelection};
+use crate::lights::{Light, LightSelection, LightTree};
 use crate::materials::{Material, MaterialKind, TexturePoint};
 use crate::math::{Aabb, Frame, Ray, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
@@ -107,6 +107,8 @@ pub struct World {
     pub(crate) camera: Camera,
     pub(crate) bounds: Aabb,
     pub(crate) light_distribution: Option<Distribution1d>,
+    /// The light BVH under `LightSelection::Tree` (then `light_distribution` is `None`).
+    pub(crate) light_tree: Option<LightTree>,
     pub(crate) light_selection: LightSelection,
     pub(crate) bvh_split: BvhSplit,
     pub(crate) bvh_build_seconds: f64,
@@ -171,7 +173,13 @@ impl World {
 
     pub fn set_light_selection(&mut self, selection: LightSelection) {
         self.light_selection = selection;
+        self.light_tree = None;
         let weights: Vec<f32> = match selection {
+            LightSelection::Tree => {
+                self.light_tree = LightTree::new(&self.lights);
+                self.light_distribution = None;
+                return;
+            }
             LightSelection::Uniform => vec![1.0; self.lights.len()],
             LightSelection::Power => {
                 // An infinite light's "power" (radiance times the scene's cross-section) says
@@ -212,10 +220,39 @@ impl World {
         self.light_distribution = Distribution1d::new(&weights);
     }
 
-    /// Probability of choosing light `i` for next-event estimation.
+    /// Probability of choosing light `i` for next-event estimation under the selections that
+    /// do not depend on the shading point (0 under `LightSelection::Tree`: see `light_pmf_at`).
     #[inline]
     pub fn light_pmf(&self, i: u32) -> f32 {
         self.light_distribution.as_ref().map_or(0.0, |d| d.pmf(i as usize))
+    }
+
+    /// Probability of choosing light `i` for next-event estimation at `p`.
+    #[inline]
+    pub fn light_pmf_at(&self, p: Vec3, i: u32) -> f32 {
+        match &self.light_tree {
+            Some(tree) => tree.pmf(p, i),
+            None => self.light_pmf(i),
+        }
+    }
+
+    /// Chooses a light for next-event estimation at `p` with `u`: its index, its probability
+    /// and `u` rescaled within its share (for the point on the light). `None` without lights,
+    /// or where the tree finds that none reaches `p`.
+    #[inline]
+    pub fn choose_light(&self, p: Vec3, u: f32) -> Option<(usize, f32, f32)> {
+        if let Some(tree) = &self.light_tree {
+            let s = tree.sample(p, u)?;
+            return Some((s.index, s.pmf, s.remapped));
+        }
+        let pick = self.light_distribution.as_ref()?.sample(u);
+        Some((pick.index, pick.pmf, pick.remapped))
+    }
+
+    /// Whether next-event estimation has any light to choose.
+    #[inline]
+    pub fn can_choose_lights(&self) -> bool {
+        self.light_distribution.is_some() || self.light_tree.is_some()
     }
 
     /// Closest hit along the ray within its interval.

@@ -3,7 +3,7 @@
 //! 1 lx -> 1/683 W/m^2), as Blender's importer does.
 
 use super::scene::Walk;
-use crate::describe::{LightDesc, LightKind, Matrix4, SceneDesc};
+use crate::describe::{LightDesc, LightKind, Matrix4, SceneDesc, SpotFalloff};
 use crate::error::SourceLoc;
 use crate::io::gltf::{GltfFile, Node};
 use crate::math::{rgb, vec3, Vec3};
@@ -68,6 +68,7 @@ pub fn punctual(file: &GltfFile, walk: &Walk, d: &mut SceneDesc) -> Result<(), S
                     intensity: power,
                     cutoff_degrees: outer.to_degrees() as f32,
                     beam_degrees: inner.to_degrees() as f32,
+                    falloff: SpotFalloff::Gltf,
                 }
             }
             other => return Err(format!("{lp}.type: {other:?} is not point, spot or directional")),

@@ -92,3 +92,6 @@ pub(crate) fn mul(a: &crate::describe::Matrix4, b: &crate::describe::Matrix4) ->
     }
     m
 }
+
+#[cfg(test)]
+mod tests;

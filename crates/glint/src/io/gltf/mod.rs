@@ -12,7 +12,7 @@ mod primitive;
 
 pub use accessor::{read_accessor, read_indices, Accessor};
 pub use image::{decode_image, image_bytes, RgbaImage, MAX_IMAGE_PIXELS};
-pub use primitive::{read_primitive, triangle_mode, PrimitiveData, PrimitiveMode};
+pub use primitive::{assemble_triangles, read_primitive, triangle_mode, PrimitiveData, PrimitiveMode};
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
