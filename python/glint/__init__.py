@@ -57,11 +57,16 @@ def _path(value: Any, arg: str) -> str:
     return os.fspath(value)
 
 
-def load_file(path: Union[str, os.PathLike], **defines: Any) -> Scene:
-    """Reads a scene file of any format glint reads (.json, Mitsuba .xml, .obj, .ply).
+def load_file(
+    path: Union[str, os.PathLike], *, camera: Union[str, int, None] = None, **defines: Any
+) -> Scene:
+    """Reads a scene file of any format glint reads (.json, Mitsuba .xml, glTF .gltf and
+    .glb, .obj, .ply).
 
-    Keyword arguments override the Mitsuba scene's ``<default>`` values, as the command
-    line's ``-D name=value`` does (``spp=64``); they are an error for other formats.
+    ``camera`` picks a glTF file's camera by index or name, as the command line's
+    ``--camera`` does (default: the first camera node of the default scene). Other keyword
+    arguments override the Mitsuba scene's ``<default>`` values, as the command line's
+    ``-D name=value`` does (``spp=64``); they are an error for other formats.
     Raises SceneError (with ``.file``, ``.line``) for a scene that cannot be read.
     """
     path = _path(path, "path")
@@ -73,7 +78,8 @@ def load_file(path: Union[str, os.PathLike], **defines: Any) -> Scene:
             return str(v)
         raise TypeError(f"define {v!r}: expected a str, int, float or bool")
 
-    return _glint.load_file(path, [(k, text(v)) for k, v in defines.items()])
+    cam = None if camera is None else str(camera)
+    return _glint.load_file(path, [(k, text(v)) for k, v in defines.items()], cam)
 
 
 def _json_default(o: Any) -> Any:

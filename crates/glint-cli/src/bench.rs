@@ -5,10 +5,11 @@
 //! in flight per thread), in runs interleaved with the single-ray ones so that the two are
 //! measured under the same load, and checks that both give the same answers ray by ray.
 
+use crate::bench_curves::{bench_curves, CurveBench};
 use crate::{meshsrc, rays};
 use clap::Args;
 use glint::accel::{BvhSplit, SimdPath, TriangleHit, BATCH_LANES};
-use glint::geometry::{MeshAccel, TriangleMesh};
+use glint::geometry::{CurveBasis, MeshAccel, TriangleMesh};
 use glint::math::Ray;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -17,8 +18,15 @@ use std::time::Instant;
 #[derive(Args)]
 pub struct BenchArgs {
     /// Mesh file (.obj, .ply; all groups together) or synthetic:TRIANGLES.
+    #[arg(long, required_unless_present = "curves", conflicts_with = "curves")]
+    mesh: Option<String>,
+    /// A Mitsuba curve file (x y z radius per line, a blank line between curves) to trace
+    /// instead of a mesh; `--basis` says how its points make curves.
     #[arg(long)]
-    mesh: String,
+    curves: Option<PathBuf>,
+    /// The curves' basis: linear (Mitsuba's linearcurve) or bspline (bsplinecurve).
+    #[arg(long, default_value = "bspline", value_parser = ["linear", "bspline"])]
+    basis: String,
     /// Ray file: float32 records (ox, oy, oz, tmin, dx, dy, dz, tmax).
     #[arg(long)]
     rays: PathBuf,
@@ -63,7 +71,23 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
         _ => MeshAccel::default(),
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(a.threads).build().map_err(|e| e.to_string())?;
-    let flat = meshsrc::load(&a.mesh)?;
+    let Some(mesh_name) = &a.mesh else {
+        let file = a.curves.as_deref().expect("clap requires --mesh or --curves");
+        let basis = if a.basis == "linear" { CurveBasis::Linear } else { CurveBasis::BSpline };
+        let out = bench_curves(CurveBench {
+            file,
+            basis,
+            rays: &a.rays,
+            hits: a.hits.as_ref(),
+            repeat: a.repeat,
+            simd,
+            split: a.split,
+            pool: &pool,
+        })?;
+        print_result(&out, a.json);
+        return Ok(());
+    };
+    let flat = meshsrc::load(mesh_name)?;
     let rays = rays::read_rays(&a.rays)?;
     if rays.is_empty() {
         return Err(format!("{}: no rays", a.rays.display()));
@@ -138,7 +162,7 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
     }
     let n = rays.len() as f64;
     let out = serde_json::json!({
-        "mesh": a.mesh,
+        "mesh": mesh_name,
         "triangles": triangles,
         "rays": rays.len(),
         "threads": a.threads,
@@ -165,14 +189,18 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
         o.insert("batch_closest_speedup".into(), (closest_s / batch_closest_s).into());
         o.insert("batch_occluded_speedup".into(), (occluded_s / batch_occluded_s).into());
     }
-    if a.json {
+    print_result(&out, a.json);
+    Ok(())
+}
+
+fn print_result(out: &serde_json::Value, json: bool) {
+    if json {
         println!("{out}");
     } else {
         for (k, v) in out.as_object().into_iter().flatten() {
             println!("{k:<26} {v}");
         }
     }
-    Ok(())
 }
 
 /// The batch API must give each ray the single-ray answer: the same triangle and the same

@@ -38,7 +38,8 @@ enum Command {
 
 #[derive(Args)]
 pub struct SceneArgs {
-    /// Scene file: glint JSON (.json), Mitsuba 3 XML (.xml), or a bare OBJ or PLY mesh.
+    /// Scene file: glint JSON (.json), Mitsuba 3 XML (.xml), glTF 2.0 (.gltf, .glb), or a
+    /// bare OBJ or PLY mesh.
     pub scene: PathBuf,
     /// BVH split strategy: sah (binned surface area heuristic) or median (the paper's).
     #[arg(long, default_value = "sah", value_parser = parse_split)]
@@ -46,6 +47,10 @@ pub struct SceneArgs {
     /// Override a Mitsuba `<default>` value: -D name=value (repeatable).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
     pub define: Vec<(String, String)>,
+    /// glTF: the camera to render through, by index in the file's `cameras` or by name
+    /// (default: the first camera node of the default scene).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub camera: Option<String>,
 }
 
 #[derive(Args)]
@@ -277,7 +282,7 @@ impl SceneArgs {
     pub fn open(&self) -> Result<Session, glint::Error> {
         let defines =
             self.define.iter().map(|(name, value)| Define { name: name.clone(), value: value.clone() }).collect();
-        let mut s = Session::open(&self.scene, &ReadOptions { defines })?;
+        let mut s = Session::open(&self.scene, &ReadOptions { defines, camera: self.camera.clone() })?;
         s.set_build_options(BuildOptions { bvh_split: self.bvh });
         Ok(s)
     }

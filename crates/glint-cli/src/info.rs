@@ -7,20 +7,24 @@ use std::io::Write;
 pub fn info_cmd(a: SceneArgs) -> Result<(), glint::Error> {
     let start = std::time::Instant::now();
     let mut session = a.open()?;
+    let summary = session.description().summary.clone();
     let s = session.world()?;
     let load_s = start.elapsed().as_secs_f64();
     // A closed pipe (`glint info SCENE | head -1`) ends the listing quietly.
-    let _ = print_info(&a, &s, load_s);
+    let _ = print_info(&a, &s, &summary, load_s);
     Ok(())
 }
 
-fn print_info(a: &SceneArgs, s: &glint::world::World, load_s: f64) -> std::io::Result<()> {
+fn print_info(a: &SceneArgs, s: &glint::world::World, summary: &[String], load_s: f64) -> std::io::Result<()> {
     let mut out = std::io::stdout().lock();
     let spheres = s.instances().iter().filter(|i| matches!(i.shape, ShapeRef::Sphere(_))).count();
     let curve_sets = s.curves().len();
     let mesh_instances = s.instances().len() - spheres - curve_sets;
     let unique_tris: usize = s.meshes().iter().map(|m| m.indices.len()).sum();
     writeln!(out, "scene            {}", a.scene.display())?;
+    for line in summary {
+        writeln!(out, "{line}")?;
+    }
     writeln!(
         out,
         "shapes           {} ({} mesh instances, {} spheres, {} curve sets)",

@@ -1,6 +1,7 @@
 //! The `glint` command line: a thin front end over the `glint` library's session API.
 
 mod bench;
+mod bench_curves;
 mod commands;
 mod info;
 mod merge;

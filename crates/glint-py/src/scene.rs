@@ -27,12 +27,20 @@ impl Scene {
     }
 }
 
-/// Reads a scene file; `defines` are (name, value) Mitsuba `<default>` overrides.
+/// Reads a scene file; `defines` are (name, value) Mitsuba `<default>` overrides; `camera`
+/// picks a glTF camera by index or name.
 #[pyfunction]
-pub fn load_file(py: Python<'_>, path: PathBuf, defines: Vec<(String, String)>) -> PyResult<Scene> {
+#[pyo3(signature = (path, defines, camera=None))]
+pub fn load_file(
+    py: Python<'_>,
+    path: PathBuf,
+    defines: Vec<(String, String)>,
+    camera: Option<String>,
+) -> PyResult<Scene> {
     guard(|| {
         let defines = defines.into_iter().map(|(name, value)| Define { name, value }).collect();
-        let session = py.detach(|| Session::open(&path, &ReadOptions { defines })).map_err(|e| scene_error(py, e))?;
+        let opts = ReadOptions { defines, camera };
+        let session = py.detach(|| Session::open(&path, &opts)).map_err(|e| scene_error(py, e))?;
         Ok(Scene { session })
     })
 }

@@ -4,8 +4,8 @@
 //! (η(wo)/η(wi))² radiance scaling is what makes the two sides agree.
 
 use glint::bsdf::{
-    fresnel_dielectric, BlendBsdf, BlendPart, Bsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong, PlasticParams,
-    Principled, PrincipledInputs, PrincipledRates,
+    fresnel_dielectric, BlendBsdf, BlendPart, Bsdf, GltfPbr, Microfacet, MicrofacetKind, PPlasticParams, Phong,
+    PlasticParams, Principled, PrincipledInputs, PrincipledRates,
 };
 use glint::bsdf::{Diffuse, RoughConductor, RoughDielectric};
 use glint::math::{rgb, Rgb, Vec3};
@@ -104,7 +104,29 @@ fn bsdfs() -> Vec<(&'static str, Bsdf)> {
                 },
             )),
         ),
+        ("glTF metal and dielectric with sheen", gltf(0.0, true)),
+        ("glTF thin transmission", gltf(0.7, true)),
+        ("glTF volume transmission", gltf(0.7, false)),
     ]
+}
+
+/// A glTF material with every reciprocal lobe (the clearcoat is not: the extension weights
+/// it by the Fresnel term of the view direction alone).
+fn gltf(transmission: f32, thin_walled: bool) -> Bsdf {
+    Bsdf::GltfPbr(GltfPbr {
+        base_color: rgb(0.8, 0.5, 0.3),
+        metallic: 0.3,
+        roughness: 0.5,
+        ior: 1.5,
+        specular: 0.8,
+        specular_color: rgb(1.2, 0.9, 0.7),
+        transmission,
+        thin_walled,
+        clearcoat: 0.0,
+        clearcoat_roughness: 0.0,
+        sheen_color: rgb(0.4, 0.5, 0.6),
+        sheen_roughness: 0.4,
+    })
 }
 
 fn principled(spec_trans: f32) -> Bsdf {
@@ -129,6 +151,7 @@ fn eta_of(bsdf: &Bsdf, w: Vec3) -> f32 {
     match bsdf {
         Bsdf::RoughDielectric(RoughDielectric { eta, .. }) if w.z < 0.0 => *eta,
         Bsdf::Principled(p) if w.z < 0.0 && p.spec_trans > 0.0 => p.eta,
+        Bsdf::GltfPbr(m) if w.z < 0.0 && !m.thin_walled => m.ior,
         _ => 1.0,
     }
 }
@@ -152,6 +175,7 @@ fn bsdfs_are_reciprocal() {
                     fresnel_dielectric(wo.dot(h) * h.z.signum(), *eta).cos_t
                 }
                 Bsdf::Principled(p) if p.spec_trans > 0.0 => fresnel_dielectric(wo.dot(h) * h.z.signum(), p.eta).cos_t,
+                Bsdf::GltfPbr(m) if !m.thin_walled => fresnel_dielectric(wo.dot(h) * h.z.signum(), m.ior).cos_t,
                 _ => 1.0,
             };
             if [wo.z, wi.z, wo.dot(h), wi.dot(h), cos_t].iter().any(|c| c.abs() < 0.05) {

@@ -7,7 +7,7 @@ mod common;
 use common::bsdf_check::{chi2_of, dir, draw_samples, integrate, BsdfCase, Integrals, Samples};
 use common::stats::{sidak, z_critical, FALSE_ALARM};
 use glint::bsdf::{
-    normal_map_frame, BlendBsdf, BlendPart, Bsdf, HairBsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong,
+    normal_map_frame, BlendBsdf, BlendPart, Bsdf, GltfPbr, HairBsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong,
     PlasticParams, Principled, PrincipledInputs, PrincipledRates, ShadedBsdf,
 };
 use glint::bsdf::{Conductor, Diffuse, RoughConductor, RoughDielectric};
@@ -148,7 +148,63 @@ fn cases() -> Vec<BsdfCase> {
     }
     principled_and_blend_cases(&mut v);
     hair_cases(&mut v);
+    gltf_cases(&mut v);
     v
+}
+
+/// The glTF default material (white rough metal) with `f` applied.
+pub fn gltf(f: impl FnOnce(&mut GltfPbr)) -> Bsdf {
+    let mut m = GltfPbr::default_material();
+    f(&mut m);
+    Bsdf::GltfPbr(m)
+}
+
+/// The glTF BRDF: each lobe and extension alone, then together, seen from above and (for
+/// thin walls and volume boundaries) from below; 110° and 130° are beyond the critical
+/// angle of ior 1.5 from inside.
+fn gltf_cases(v: &mut Vec<BsdfCase>) {
+    let copper = rgb(0.95, 0.64, 0.54);
+    let metal = |r: f32| gltf(|m| (m.base_color, m.roughness) = (copper, r));
+    let dielectric = |r: f32| gltf(|m| (m.base_color, m.metallic, m.roughness) = (rgb(0.7, 0.3, 0.1), 0.0, r));
+    let mut add = |name: &str, b: Bsdf, wos: &[f32]| {
+        for &wo in wos {
+            v.push(case(&format!("glTF {name}"), b.clone(), wo, false));
+        }
+    };
+    add("metal 0.5", metal(0.5), &[0.0, 45.0, 80.0]);
+    add("metal 0.15", metal(0.15), &[30.0]);
+    add("dielectric 0.5", dielectric(0.5), &[0.0, 60.0, 85.0]);
+    add("dielectric 0.15", dielectric(0.15), &[45.0]);
+    let lambert = gltf(|m| (m.base_color, m.metallic, m.specular) = (rgb(0.8, 0.5, 0.2), 0.0, 0.0));
+    add("specular 0", lambert, &[30.0]);
+    let tinted = gltf(|m| {
+        (m.base_color, m.metallic, m.roughness, m.ior) = (rgb(0.2, 0.5, 0.3), 0.3, 0.4, 1.8);
+        (m.specular, m.specular_color) = (0.7, rgb(1.5, 0.8, 0.4));
+    });
+    add("specular colour, ior 1.8, metallic 0.3", tinted, &[50.0]);
+    let thin = gltf(|m| (m.base_color, m.metallic, m.roughness, m.transmission) = (rgb(0.9, 0.8, 0.5), 0.0, 0.3, 0.8));
+    add("thin transmission 0.8", thin, &[30.0, 150.0]);
+    let volume = gltf(|m| {
+        (m.base_color, m.metallic, m.roughness, m.transmission) = (rgb(0.9, 0.9, 0.7), 0.0, 0.3, 1.0);
+        m.thin_walled = false;
+    });
+    add("volume transmission", volume, &[30.0, 75.0, 150.0, 130.0]);
+    let coated = gltf(|m| {
+        (m.base_color, m.metallic, m.roughness) = (rgb(0.1, 0.3, 0.8), 0.0, 0.6);
+        (m.clearcoat, m.clearcoat_roughness) = (1.0, 0.2);
+    });
+    add("clearcoat", coated, &[20.0, 70.0]);
+    let sheen = gltf(|m| {
+        (m.base_color, m.metallic, m.roughness) = (rgb(0.3, 0.1, 0.1), 0.0, 0.7);
+        (m.sheen_color, m.sheen_roughness) = (rgb(0.9, 0.8, 0.8), 0.4);
+    });
+    add("sheen", sheen, &[10.0, 60.0]);
+    let all = gltf(|m| {
+        (m.base_color, m.metallic, m.roughness, m.transmission) = (rgb(0.8, 0.6, 0.3), 0.4, 0.35, 0.5);
+        (m.clearcoat, m.clearcoat_roughness, m.sheen_color, m.sheen_roughness) = (0.5, 0.1, rgb(0.5, 0.5, 0.6), 0.5);
+        (m.ior, m.specular, m.thin_walled) = (1.4, 0.8, false);
+    });
+    add("every lobe, volume", all, &[40.0, 140.0, 110.0]);
 }
 
 /// Mitsuba's `hair`, seen from directions along, across and against the fibre (its frame:

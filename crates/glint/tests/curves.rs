@@ -221,6 +221,16 @@ fn check_curve(basis: CurveBasis, pts: Vec<[f32; 4]>, seeds: &[f32]) -> Result<(
             prop_assert_eq!(curves.intersect_with(&ray, p), hit, "{:?}", p);
         }
         prop_assert_eq!(curves.intersect_brute_force(&ray), hit);
+        // Any-hit occlusion answers as the closest hit does, on every path, also with the
+        // ray cut just before or just after the hit.
+        let mut cut = ray;
+        for t_max in [ray.t_max, hit.map_or(ray.t_max, |h| h.t), hit.map_or(ray.t_max, |h| h.t.next_up())] {
+            cut.t_max = t_max;
+            let blocked = curves.intersect_with(&cut, SimdPath::Scalar).is_some();
+            for &p in &paths {
+                prop_assert_eq!(curves.occluded_with(&cut, p), blocked, "{:?} t_max {}", p, t_max);
+            }
+        }
         let o = [ray.origin.x as f64, ray.origin.y as f64, ray.origin.z as f64];
         let d = [ray.dir.x as f64, ray.dir.y as f64, ray.dir.z as f64];
         let refr = reference(basis, &pts, &segments, o, d);

@@ -92,6 +92,7 @@ fn many_lights(sky: bool, deltas: bool) -> World {
                         intensity: c * 0.2,
                         cutoff: 0.5,
                         beam: 0.35,
+                        gltf_falloff: false,
                     })
                 }
             }

@@ -21,7 +21,7 @@ fn write(path: &Path, text: &str) {
 }
 
 fn read(path: &Path) -> Result<SceneDesc, String> {
-    glint::formats::read(path, &ReadOptions { defines: Vec::<Define>::new() }).map_err(|e| e.to_string())
+    glint::formats::read(path, &ReadOptions { defines: Vec::<Define>::new(), camera: None }).map_err(|e| e.to_string())
 }
 
 const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="40"/>

@@ -82,8 +82,39 @@ pub fn read_mesh_file(
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             Ok(vec![LoadedGroup::primitive(mesh)])
         }
+        "gltf" | "glb" => Ok(vec![LoadedGroup::primitive(gltf_primitive(path, shape_index, face_normals, split)?)]),
         _ => Err(format!("{}: unknown mesh format (expected .obj, .ply or .serialized)", path.display())),
     }
+}
+
+/// Primitive `flat` of a glTF file (see [`crate::io::gltf::GltfFile::primitive_at`]), with
+/// its second texture coordinate set and vertex colours as mesh attributes.
+fn gltf_primitive(path: &Path, flat: u32, face_normals: bool, split: BvhSplit) -> Result<TriangleMesh, String> {
+    use crate::geometry::{AttributeScope, MeshAttribute};
+    use crate::materials::{ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, UV1_ATTRIBUTE};
+    let at = |e: String| format!("{}: {e}", path.display());
+    let f = crate::io::gltf::open_cached(path).map_err(at)?;
+    let (mesh, prim) = f.primitive_at(flat as usize).ok_or_else(|| at(format!("no primitive {flat}")))?;
+    let p = crate::io::gltf::read_primitive(&f, mesh, prim).map_err(at)?;
+    let attribute = |name: &str, dim: usize, values: Vec<f32>| MeshAttribute {
+        name: name.into(),
+        scope: AttributeScope::Vertex,
+        dim,
+        values,
+    };
+    let mut attributes = Vec::new();
+    if let Some(uv1) = &p.uv1 {
+        attributes.push(attribute(UV1_ATTRIBUTE, 3, uv1.iter().flat_map(|t| [t[0], t[1], 0.0]).collect()));
+    }
+    if let Some(c) = &p.colors {
+        attributes.push(attribute(COLOR_ATTRIBUTE, 3, c.iter().flat_map(|c| [c[0], c[1], c[2]]).collect()));
+        attributes.push(attribute(ALPHA_ATTRIBUTE, 1, c.iter().map(|c| c[3]).collect()));
+    }
+    let normals = if face_normals { None } else { p.normals };
+    let ctx = format!("meshes[{mesh}].primitives[{prim}]");
+    TriangleMesh::new(p.positions, normals, p.uv0, p.indices, split)
+        .and_then(|m| m.with_attributes(attributes))
+        .map_err(|e| at(format!("{ctx}: {e}")))
 }
 
 /// Material for an MTL entry (used when an OBJ shape names no material).

@@ -6,6 +6,7 @@
 
 mod builder;
 mod driver;
+mod gltf;
 mod media;
 mod validate;
 
@@ -68,6 +69,8 @@ pub(crate) fn transform_of(m: &Matrix4) -> Result<Transform, Error> {
 #[derive(Default)]
 struct TextureCache {
     bitmaps: HashMap<(PathBuf, bool), Arc<Bitmap>>,
+    /// glTF images by file, image index and whether sRGB-decoded.
+    gltf_images: HashMap<(PathBuf, usize, bool), Arc<crate::io::gltf::RgbaImage>>,
 }
 
 impl TextureCache {
@@ -92,6 +95,7 @@ impl TextureCache {
             TextureDesc::MeshAttribute { name, scale, .. } => {
                 Texture::MeshAttribute { name: name.clone(), scale: *scale }
             }
+            TextureDesc::Gltf(d) => Texture::Gltf(self.gltf_texture(d)?),
         })
     }
 }
@@ -213,6 +217,7 @@ fn material_kind(m: &MaterialModel, textures: &mut TextureCache) -> Result<Mater
             h.azimuthal_roughness,
             h.scale_tilt,
         )),
+        MaterialModel::Gltf(g) => gltf::gltf_kind(g, textures)?,
     })
 }
 
@@ -254,8 +259,9 @@ fn add_light(b: &mut WorldBuilder, l: &LightKind, textures: &mut TextureCache) -
         LightKind::Point { position, intensity } => {
             b.add_light(Light::Point { position: *position, intensity: *intensity })
         }
-        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees } => {
+        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees, falloff } => {
             b.add_light(Light::Spot {
+                gltf_falloff: *falloff == crate::describe::SpotFalloff::Gltf,
                 position: *position,
                 frame: Frame::from_normal(direction.normalize()),
                 intensity: *intensity,

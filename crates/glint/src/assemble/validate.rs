@@ -170,6 +170,15 @@ fn texture(t: &TextureDesc, what: &str) -> Result<(), String> {
                 return Err(format!("mesh attribute name '{name}' must start with 'vertex_' or 'face_'"));
             }
         }
+        TextureDesc::Gltf(g) => {
+            color(g.scale, what)?;
+            if g.texcoord > 1 {
+                return Err(format!("glTF texture coordinate set {} (glint reads sets 0 and 1)", g.texcoord));
+            }
+            if g.transform.iter().flatten().any(|v| !v.is_finite()) {
+                return Err("glTF texture transform must be finite".into());
+            }
+        }
     }
     Ok(())
 }
@@ -257,11 +266,51 @@ fn material(m: &MaterialModel) -> Result<(), String> {
         }
         MaterialModel::NormalMap { nested, .. } | MaterialModel::Mask { nested, .. } => material(nested)?,
         MaterialModel::Principled(p) => principled(p, eta_ok)?,
+        MaterialModel::Gltf(g) => gltf_material(g, eta_ok)?,
         MaterialModel::Blend(b) => {
             // Each part is checked as a material of its own (its textures included).
             material(&b.first.model).map_err(|e| format!("blend, first part: {e}"))?;
             material(&b.second.model).map_err(|e| format!("blend, second part: {e}"))?;
         }
+    }
+    Ok(())
+}
+
+/// A glTF material's factors: the specification's ranges ([0, 1] but for the index of
+/// refraction and the attenuation distance), so that a BSDF never sees a value it has no
+/// meaning for.
+fn gltf_material(
+    g: &crate::describe::GltfMaterialDesc,
+    eta_ok: impl Fn(f32) -> Result<(), String>,
+) -> Result<(), String> {
+    eta_ok(g.ior)?;
+    for (name, c) in [
+        ("baseColorFactor", g.base_color),
+        ("specularColorFactor", g.specular_color),
+        ("sheenColorFactor", g.sheen_color),
+        ("attenuationColor", g.attenuation_color),
+    ] {
+        color(c, name)?;
+    }
+    for (name, v) in [
+        ("alpha", g.base_alpha),
+        ("metallicFactor", g.metallic),
+        ("roughnessFactor", g.roughness),
+        ("specularFactor", g.specular),
+        ("transmissionFactor", g.transmission),
+        ("clearcoatFactor", g.clearcoat),
+        ("clearcoatRoughnessFactor", g.clearcoat_roughness),
+        ("sheenRoughnessFactor", g.sheen_roughness),
+    ] {
+        if !(0.0..=1.0).contains(&v) {
+            return Err(format!("glTF material: {name} {v} must lie in [0, 1]"));
+        }
+    }
+    if !g.normal_scale.is_finite() {
+        return Err(format!("glTF material: normalTexture.scale {} must be finite", g.normal_scale));
+    }
+    if !(g.attenuation_distance > 0.0) {
+        return Err(format!("glTF material: attenuationDistance {} must be positive", g.attenuation_distance));
     }
     Ok(())
 }
@@ -284,7 +333,7 @@ fn principled(p: &crate::describe::PrincipledDesc, eta_ok: impl Fn(f32) -> Resul
                 unit(*color1)?;
             }
             // Images are clamped to [0, 1] by their formats or read as given (EXR).
-            TextureDesc::Bitmap { .. } | TextureDesc::MeshAttribute { .. } => {}
+            TextureDesc::Bitmap { .. } | TextureDesc::MeshAttribute { .. } | TextureDesc::Gltf(_) => {}
         }
     }
     for (rate, name) in [
@@ -309,7 +358,7 @@ fn light(l: &LightKind) -> Result<(), String> {
             vector(*position, "position")?;
             color(*intensity, "intensity")
         }
-        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees } => {
+        LightKind::Spot { position, direction, intensity, cutoff_degrees, beam_degrees, .. } => {
             vector(*position, "position")?;
             direction_of(*direction, "spot direction (its target equals its position?)")?;
             color(*intensity, "intensity")?;

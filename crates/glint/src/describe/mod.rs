@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 mod aov;
 mod blend;
 mod camera;
+mod gltf;
 mod integrator;
 pub mod limits;
 mod medium;
@@ -24,6 +25,7 @@ mod sampling;
 pub use aov::Aov;
 pub use blend::{BlendDesc, BlendPartDesc};
 pub use camera::{CropWindow, FovAxis, Projection};
+pub use gltf::{GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, GltfWrap};
 pub use integrator::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
 pub use medium::{GridFilter, GridVolumeDesc, GridWrap, MediumDesc, PhaseDesc, VolumeDesc};
 pub use principled::{principled_eta_of_specular, PrincipledDesc};
@@ -55,6 +57,10 @@ pub struct SceneDesc {
     /// Participating media, referred to by index from shapes and the camera.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub media: Vec<MediumDesc>,
+    /// What the reader read, one line each, for `glint info` (a glTF file's nodes,
+    /// meshes, triangles, ...); empty for formats that say nothing more than the world.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub summary: Vec<String>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -255,6 +261,8 @@ pub enum MaterialModel {
     /// the pigments, or Mitsuba's `sigma_a` times `scale`), `eta` interior over exterior,
     /// the roughnesses in [0, 1] and the scale tilt in degrees.
     Hair(HairDesc),
+    /// A glTF 2.0 material (metallic-roughness and its KHR extensions).
+    Gltf(GltfMaterialDesc),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -294,9 +302,26 @@ pub enum TextureDesc {
         scale: f32,
         loc: SourceLoc,
     },
+    /// An image of a glTF file with its sampler and texture coordinate set.
+    Gltf(GltfTextureDesc),
 }
 
 impl TextureDesc {
+    /// The file the build reads for this texture, if any.
+    pub fn file(&self) -> Option<&PathBuf> {
+        match self {
+            TextureDesc::Bitmap { file, .. } | TextureDesc::Gltf(GltfTextureDesc { file, .. }) => Some(file),
+            TextureDesc::Constant { .. } | TextureDesc::Checkerboard { .. } | TextureDesc::MeshAttribute { .. } => None,
+        }
+    }
+
+    pub fn file_mut(&mut self) -> Option<&mut PathBuf> {
+        match self {
+            TextureDesc::Bitmap { file, .. } | TextureDesc::Gltf(GltfTextureDesc { file, .. }) => Some(file),
+            TextureDesc::Constant { .. } | TextureDesc::Checkerboard { .. } | TextureDesc::MeshAttribute { .. } => None,
+        }
+    }
+
     pub fn constant(color: Rgb) -> TextureDesc {
         TextureDesc::Constant { color }
     }
@@ -481,6 +506,9 @@ pub enum LightKind {
         intensity: Rgb,
         cutoff_degrees: f32,
         beam_degrees: f32,
+        /// How the intensity falls between the cones (Mitsuba's unless a glTF file says).
+        #[serde(default, skip_serializing_if = "SpotFalloff::is_linear")]
+        falloff: SpotFalloff,
     },
     /// `direction` is where the light travels.
     Directional {
@@ -517,6 +545,23 @@ pub enum LightKind {
     },
 }
 
+/// How a spot light's intensity falls from the beam's cone to the cutoff's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SpotFalloff {
+    /// Linear in the angle (Mitsuba's `spot`).
+    #[default]
+    Linear,
+    /// `KHR_lights_punctual`'s: linear in the cosine between the cones, then squared.
+    Gltf,
+}
+
+impl SpotFalloff {
+    pub fn is_linear(&self) -> bool {
+        *self == SpotFalloff::Linear
+    }
+}
+
 impl SceneDesc {
     /// A description with nothing in it but a camera and film; readers and code fill it.
     pub fn empty(camera: CameraDesc, film: FilmDesc) -> SceneDesc {
@@ -534,6 +579,7 @@ impl SceneDesc {
             lights: Vec::new(),
             warnings: Vec::new(),
             media: Vec::new(),
+            summary: Vec::new(),
         }
     }
 
@@ -561,7 +607,7 @@ impl SceneDesc {
         };
         for m in &self.materials {
             for t in m.model.textures() {
-                if let TextureDesc::Bitmap { file, .. } = t {
+                if let Some(file) = t.file() {
                     add(file);
                 }
             }
@@ -575,7 +621,7 @@ impl SceneDesc {
             {
                 add(file);
             }
-            if let Some(Emission { radiance: TextureDesc::Bitmap { file, .. }, .. }) = &s.emission {
+            if let Some(file) = s.emission.as_ref().and_then(|e| e.radiance.file()) {
                 add(file);
             }
         }
@@ -613,7 +659,7 @@ impl SceneDesc {
         };
         for m in &mut self.materials {
             for t in m.model.textures_mut() {
-                if let TextureDesc::Bitmap { file, .. } = t {
+                if let Some(file) = t.file_mut() {
                     map(file)?;
                 }
             }
@@ -627,7 +673,7 @@ impl SceneDesc {
             {
                 map(file)?;
             }
-            if let Some(Emission { radiance: TextureDesc::Bitmap { file, .. }, .. }) = &mut s.emission {
+            if let Some(file) = s.emission.as_mut().and_then(|e| e.radiance.file_mut()) {
                 map(file)?;
             }
         }
@@ -685,6 +731,7 @@ impl MaterialModel {
                 v
             }
             MaterialModel::Principled(p) => p.textures().into_iter().map(|(_, t)| t).collect(),
+            MaterialModel::Gltf(g) => g.textures(),
             MaterialModel::Blend(b) => {
                 let mut v = vec![&b.weight];
                 v.extend(b.first.model.textures());
@@ -718,6 +765,7 @@ impl MaterialModel {
                 v
             }
             MaterialModel::Principled(p) => p.textures_mut().into_iter().collect(),
+            MaterialModel::Gltf(g) => g.textures_mut(),
             MaterialModel::Blend(b) => {
                 let mut v = vec![&mut b.weight];
                 v.extend(b.first.model.textures_mut());

@@ -1069,6 +1069,7 @@ fn light_of(ctx: &Ctx, at: &str, l: &JsonLight) -> Result<LightKind, Error> {
                 intensity: intensity.rgb(),
                 cutoff_degrees: cutoff,
                 beam_degrees: beam_width.unwrap_or(cutoff * 0.75),
+                falloff: crate::describe::SpotFalloff::Linear,
             }
         }
         JsonLight::Directional { direction, irradiance } => {

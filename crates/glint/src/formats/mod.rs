@@ -1,7 +1,8 @@
 //! Scene readers: each turns a file into a [`SceneDesc`] and does nothing else (no mesh is
-//! loaded, no BVH built): the native JSON format, Mitsuba 3 XML, and a bare OBJ or PLY mesh
+//! loaded, no BVH built): the native JSON format, Mitsuba 3 XML, glTF 2.0, and a bare OBJ or PLY mesh
 //! (a preview scene around it).
 
+pub mod gltf;
 pub mod json;
 mod json_spans;
 pub mod mesh;
@@ -22,6 +23,8 @@ pub struct Define {
 #[derive(Clone, Debug, Default)]
 pub struct ReadOptions {
     pub defines: Vec<Define>,
+    /// The camera to use, by index or name, for formats with several (glTF).
+    pub camera: Option<String>,
 }
 
 /// The formats glint reads, by file extension.
@@ -30,6 +33,7 @@ pub enum SceneFormat {
     Json,
     Mitsuba,
     Mesh,
+    Gltf,
 }
 
 impl SceneFormat {
@@ -39,9 +43,10 @@ impl SceneFormat {
             "json" => Ok(SceneFormat::Json),
             "xml" => Ok(SceneFormat::Mitsuba),
             "obj" | "ply" => Ok(SceneFormat::Mesh),
+            "gltf" | "glb" => Ok(SceneFormat::Gltf),
             _ => Err(Error::at(
                 &SourceLoc::file(path),
-                "unknown scene format (expected .json, .xml, or a .obj or .ply mesh)",
+                "unknown scene format (expected .json, .xml, .gltf, .glb, or a .obj or .ply mesh)",
             )),
         }
     }
@@ -53,8 +58,12 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<SceneDesc, Error> {
     if !opts.defines.is_empty() && format != SceneFormat::Mitsuba {
         return Err(Error::at(&SourceLoc::file(path), "-D overrides apply to Mitsuba XML scenes only"));
     }
+    if opts.camera.is_some() && format != SceneFormat::Gltf {
+        return Err(Error::at(&SourceLoc::file(path), "--camera applies to glTF scenes only"));
+    }
     match format {
         SceneFormat::Mesh => mesh::describe(path),
+        SceneFormat::Gltf => gltf::read(path, opts.camera.as_deref()),
         SceneFormat::Mitsuba => mitsuba::read(path, &opts.defines),
         SceneFormat::Json => {
             let text = read_text(path)?;

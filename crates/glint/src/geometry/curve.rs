@@ -373,9 +373,51 @@ impl Curves {
         best
     }
 
-    /// Whether anything blocks the ray in `(t_min, t_max)`.
+    /// Whether anything blocks the ray in `(t_min, t_max)`: the same answer as
+    /// `intersect(ray).is_some()`, ending at the first hit found.
+    #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.intersect(ray).is_some()
+        self.occluded_with(ray, SimdPath::detect())
+    }
+
+    /// [`Curves::occluded`] with the BVH traversed by the given SIMD path (same answers).
+    pub fn occluded_with(&self, ray: &Ray, path: SimdPath) -> bool {
+        let path = if path.is_available() { path } else { SimdPath::Scalar };
+        // SAFETY (every arm): each path runs only where the CPU has it (checked above).
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 | SimdPath::Avx512 => unsafe { self.occluded_avx2(ray) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.occluded_generic::<Sse>(ray) },
+            _ => unsafe { self.occluded_generic::<Scalar>(ray) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn occluded_avx2(&self, ray: &Ray) -> bool {
+        // SAFETY: the caller checked that AVX2 and FMA are available.
+        unsafe { self.occluded_generic::<Avx2>(ray) }
+    }
+
+    /// # Safety
+    /// `S` must be available on this CPU.
+    #[inline(always)]
+    unsafe fn occluded_generic<S: Isa>(&self, ray: &Ray) -> bool {
+        let Some(rf) = RayFrame::new(ray) else { return false };
+        // The test and the acceptance of `intersect` with nothing found yet: a reference
+        // counts when its entry lies in (t_min, t_max), so the answers are the same.
+        let bound = ray.t_max as f64 * (1.0 + 1e-6);
+        let mut leaf = FnLeaf(|first: u32, count: u32, _: &Ray| {
+            self.refs[first as usize..(first + count) as usize].iter().any(|&pr| {
+                self.test_ref(&rf, pr, bound).is_some_and(|(t, _)| {
+                    let tf = t as f32;
+                    tf < ray.t_max && tf > ray.t_min
+                })
+            })
+        });
+        // SAFETY: the caller guarantees `S` is available.
+        unsafe { self.bvh.occluded::<S>(ray, &mut leaf) }
     }
 
     /// Every primitive, without the BVH (for tests).

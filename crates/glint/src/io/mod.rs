@@ -1,6 +1,7 @@
 //! File input and output: images and meshes.
 
 pub mod curves;
+pub mod gltf;
 pub mod image_io;
 pub mod layers;
 pub mod obj;
@@ -17,13 +18,15 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// What reading the file at `path` (whose bytes are `data`) reads besides it, by its
-/// format: the material files an OBJ file's `mtllib` lines name; nothing for the other
+/// format: the material files an OBJ file's `mtllib` lines name, the buffers and images a glTF
+/// file names; nothing for the other
 /// files a scene reads (PLY and serialized meshes, images, volume grids), and nothing for
 /// scene files, whose includes their description lists.
 pub fn side_files(path: &Path, data: &[u8]) -> Vec<PathBuf> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     match ext.as_str() {
         "obj" => obj::mtllib_files(data, path),
+        "gltf" | "glb" => gltf::side_files(path, data),
         _ => Vec::new(),
     }
 }

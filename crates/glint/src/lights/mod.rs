@@ -209,13 +209,15 @@ pub enum Light {
         position: Vec3,
         intensity: Rgb,
     },
-    /// Cone light; falloff is linear in angle between `cos_beam` and `cos_cutoff` (Mitsuba's).
+    /// Cone light; falloff is linear in angle between `cos_beam` and `cos_cutoff` (Mitsuba's),
+    /// or with `gltf_falloff` the square of the linear ramp in the cosine (glTF's).
     Spot {
         position: Vec3,
         frame: Frame,
         intensity: Rgb,
         cutoff: f32,
         beam: f32,
+        gltf_falloff: bool,
     },
     /// Light from direction `-direction` (i.e. travelling along `direction`) with irradiance
     /// `irradiance` on a perpendicular surface.
@@ -346,13 +348,17 @@ impl Light {
                 let dist = dist2.sqrt();
                 Some(LightSample { wi: d / dist, radiance: *intensity / dist2, pdf: 1.0, dist, delta: true })
             }
-            Light::Spot { position, frame, intensity, cutoff, beam } => {
+            Light::Spot { position, frame, intensity, cutoff, beam, gltf_falloff } => {
                 let d = *position - p;
                 let dist2 = d.length_squared();
                 let dist = dist2.sqrt();
                 let wi = d / dist;
                 let cos_t = frame.to_local(-wi).z;
-                let falloff = spot_falloff(cos_t, *cutoff, *beam);
+                let falloff = if *gltf_falloff {
+                    gltf_spot_falloff(cos_t, *cutoff, *beam)
+                } else {
+                    spot_falloff(cos_t, *cutoff, *beam)
+                };
                 if falloff <= 0.0 {
                     return None;
                 }
@@ -605,6 +611,15 @@ fn solid_angle_pdf(p: Vec3, wi: Vec3, q: Vec3, n: Vec3, pdf_area: f32) -> f32 {
     pdf_area * (q - p).length_squared() / cos_l
 }
 
+/// `KHR_lights_punctual`'s spot falloff, as its reference code computes it: the cosine's
+/// place between the outer (`cutoff`) and inner (`beam`) cones, clamped to [0, 1], squared.
+pub(crate) fn gltf_spot_falloff(cos_t: f32, cutoff: f32, beam: f32) -> f32 {
+    let (cos_outer, cos_inner) = (cutoff.cos(), beam.cos());
+    let scale = 1.0 / (cos_inner - cos_outer).max(0.001);
+    let t = (cos_t * scale - cos_outer * scale).clamp(0.0, 1.0);
+    t * t
+}
+
 fn spot_falloff(cos_t: f32, cutoff: f32, beam: f32) -> f32 {
     if cos_t <= cutoff.cos() {
         return 0.0;
@@ -628,6 +643,16 @@ pub fn scene_radius(bounds: &Aabb) -> f32 {
 mod tests {
     use super::*;
     use crate::math::vec3;
+
+    #[test]
+    fn gltf_spot_falloff_is_the_squared_ramp_in_the_cosine() {
+        let (outer, inner) = (0.6f32, 0.2f32);
+        assert_eq!(gltf_spot_falloff(1.0, outer, inner), 1.0);
+        assert_eq!(gltf_spot_falloff(outer.cos() - 0.01, outer, inner), 0.0);
+        // Half-way in cosine between the cones: a quarter.
+        let mid = 0.5 * (outer.cos() + inner.cos());
+        assert!((gltf_spot_falloff(mid, outer, inner) - 0.25).abs() < 1e-5);
+    }
 
     #[test]
     fn sphere_lights_are_sampled_only_from_the_side_they_light() {

@@ -3,11 +3,13 @@
 
 mod blend;
 mod conductor_presets;
+mod gltf;
 mod principled;
 mod roughness;
 mod surface;
 mod texture;
 pub use blend::{BlendMaterial, BlendMaterialPart};
+pub use gltf::{GltfAlpha, GltfMaterial, GltfTexture, ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, UV1_ATTRIBUTE};
 pub use principled::PrincipledMaterial;
 pub use roughness::RoughnessMap;
 pub use surface::Perturbation;
@@ -100,6 +102,8 @@ pub enum MaterialKind {
     },
     /// Mitsuba's `hair`.
     Hair(HairBsdf),
+    /// A glTF 2.0 material with its textures.
+    Gltf(GltfMaterial),
 }
 
 #[derive(Clone, Debug)]
@@ -160,6 +164,7 @@ impl MaterialKind {
             | MaterialKind::ThinDielectric { .. }
             | MaterialKind::Null => true,
             MaterialKind::Principled(p) => p.is_transmissive(),
+            MaterialKind::Gltf(g) => g.is_transmissive(),
             MaterialKind::Blend(b) => b.is_transmissive(),
             MaterialKind::Diffuse { .. }
             | MaterialKind::Phong { .. }
@@ -187,6 +192,7 @@ impl MaterialKind {
             MaterialKind::Plastic { diffuse, .. } | MaterialKind::PPlastic { diffuse, .. } => diffuse.eval(uv),
             MaterialKind::Null => Rgb::WHITE,
             MaterialKind::Principled(p) => p.base_color.eval(uv),
+            MaterialKind::Gltf(g) => g.albedo(uv),
             MaterialKind::Blend(b) => b.albedo(uv),
             MaterialKind::Black
             | MaterialKind::Hair(_)
@@ -249,6 +255,8 @@ impl MaterialKind {
                 })
             }
             MaterialKind::Hair(h) => Bsdf::Hair(*h),
+            MaterialKind::Gltf(g) if g.unlit => Bsdf::Black(Black),
+            MaterialKind::Gltf(g) => Bsdf::GltfPbr(g.bsdf(p)),
         }
     }
 }

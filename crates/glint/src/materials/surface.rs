@@ -31,7 +31,8 @@ impl MaterialKind {
             | MaterialKind::Principled(_)
             | MaterialKind::Blend(_)
             | MaterialKind::PPlastic { .. }
-            | MaterialKind::Hair(_) => None,
+            | MaterialKind::Hair(_)
+            | MaterialKind::Gltf(_) => None,
         }
     }
 

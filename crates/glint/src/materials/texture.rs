@@ -101,6 +101,10 @@ pub enum Texture {
         name: String,
         scale: f32,
     },
+    /// A glTF texture (its own sampler, texture coordinate set and transform).
+    Gltf(Arc<super::GltfTexture>),
+    /// A glTF material's opacity (alpha through its mode), grey.
+    GltfAlpha(Arc<super::GltfAlpha>),
 }
 
 impl Texture {
@@ -115,6 +119,8 @@ impl Texture {
                 };
                 a.eval(*tri, p.prim, p.bary) * *scale
             }
+            Texture::Gltf(t) => t.eval_at(p),
+            Texture::GltfAlpha(a) => Rgb::splat(a.eval_at(p)),
             _ => self.eval(p.uv),
         }
     }
@@ -152,6 +158,8 @@ impl Texture {
             }
             // Needs the hit triangle: see `eval_at`.
             Texture::MeshAttribute { .. } => Rgb::BLACK,
+            Texture::Gltf(t) => t.eval(uv),
+            Texture::GltfAlpha(a) => Rgb::splat(a.eval_at(&TexturePoint::uv(uv))),
         }
     }
 
@@ -162,6 +170,8 @@ impl Texture {
             Texture::Bitmap { image, .. } => image.mean(),
             Texture::Checkerboard { color0, color1, .. } => (*color0 + *color1) * 0.5,
             Texture::MeshAttribute { scale, .. } => Rgb::splat(0.5 * scale),
+            Texture::Gltf(t) => t.mean * t.scale,
+            Texture::GltfAlpha(a) => Rgb::splat(a.factor),
         }
     }
 }

@@ -157,6 +157,11 @@ fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
                 texture_slot(name, t, &mut out);
             }
         }
+        MaterialModel::Gltf(g) => {
+            out.push(("base_color", Slot::Color(&mut g.base_color)));
+            out.push(("metallic", Slot::Float(&mut g.metallic)));
+            out.push(("roughness", Slot::Float(&mut g.roughness)));
+        }
         // A blend's parts are not editable one by one (yet).
         MaterialModel::Blend(b) => texture_slot("weight", &mut b.weight, &mut out),
     }

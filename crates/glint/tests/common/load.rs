@@ -17,7 +17,7 @@ pub struct Loaded {
 /// Reads and builds a scene with `-D` style overrides and, optionally, a new resolution.
 pub fn load(path: &Path, defines: &[(&str, &str)], size: Option<(u32, u32)>) -> Result<Loaded, String> {
     let defines = defines.iter().map(|(n, v)| Define { name: n.to_string(), value: v.to_string() }).collect();
-    let mut s = Session::open(path, &ReadOptions { defines }).map_err(|e| e.to_string())?;
+    let mut s = Session::open(path, &ReadOptions { defines, camera: None }).map_err(|e| e.to_string())?;
     if let Some((w, h)) = size {
         s.edit().film.width = w;
         s.edit().film.height = h;

@@ -22,7 +22,7 @@ use crate::describe::{
     MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
     VolpathSettings,
 };
-use crate::describe::{CropWindow, FovAxis, PixelFilter, Projection, SamplerKind};
+use crate::describe::{CropWindow, FovAxis, PixelFilter, Projection, SamplerKind, SpotFalloff};
 use crate::error::{Error, SourceLoc};
 use crate::math::{Rgb, Transform, Vec3};
 use props::{color_of, Props};
@@ -547,6 +547,7 @@ impl<'a> Reader<'a> {
                     intensity: p.rgb_as("intensity", Rgb::WHITE, SpectrumUse::Emission)?,
                     cutoff_degrees: cutoff,
                     beam_degrees: p.float("beam_width", cutoff * 0.75)?,
+                    falloff: SpotFalloff::Linear,
                 }
             }
             "directional" => LightKind::Directional {

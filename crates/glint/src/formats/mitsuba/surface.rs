@@ -45,7 +45,8 @@ impl<'a> Reader<'a> {
                     | MaterialModel::Principled(_)
                     | MaterialModel::Blend(_)
                     | MaterialModel::PPlastic { .. }
-                    | MaterialModel::Hair(_) => return false,
+                    | MaterialModel::Hair(_)
+                    | MaterialModel::Gltf(_) => return false,
                 }
             }
         };

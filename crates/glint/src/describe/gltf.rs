@@ -1,0 +1,138 @@
+//! The description of a glTF 2.0 material (metallic-roughness with the KHR extensions
+//! Blender writes) and of a glTF texture reference (image, sampler, texture coordinate set,
+//! `KHR_texture_transform`).
+
+use crate::error::SourceLoc;
+use crate::math::Rgb;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// A sampler's wrap mode along one axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GltfWrap {
+    Repeat,
+    Clamp,
+    Mirror,
+}
+
+/// An image of a glTF file as a texture.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GltfTextureDesc {
+    /// The `.gltf` or `.glb` file the image belongs to.
+    pub file: PathBuf,
+    /// Index into the file's `images`.
+    pub image: usize,
+    /// Colour channels stored sRGB-encoded (base colour, emission) rather than linear.
+    pub srgb: bool,
+    /// Which `TEXCOORD_n` set: 0 or 1.
+    pub texcoord: u32,
+    pub wrap_s: GltfWrap,
+    pub wrap_t: GltfWrap,
+    /// Nearest-texel lookup (else bilinear).
+    pub nearest: bool,
+    /// `KHR_texture_transform` as the 2x3 matrix uv' = M (u, v, 1) (identity without it).
+    pub transform: [[f32; 3]; 2],
+    /// Multiplies the colour channels (emissive factor and strength, for instance).
+    pub scale: Rgb,
+    pub loc: SourceLoc,
+}
+
+/// How a glTF material's alpha is used.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "mode", rename_all = "lowercase")]
+pub enum GltfAlphaMode {
+    Opaque,
+    /// Opaque where alpha >= cutoff, else fully transparent.
+    Mask {
+        cutoff: f32,
+    },
+    /// Opacity alpha, rendered stochastically.
+    Blend,
+}
+
+/// A glTF material: the factors and, as [`super::TextureDesc::Gltf`], the textures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GltfMaterialDesc {
+    pub base_color: Rgb,
+    pub base_alpha: f32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_color_texture: Option<super::TextureDesc>,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Blue channel metallic, green channel roughness (linear).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub metallic_roughness_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_texture: Option<super::TextureDesc>,
+    /// `normalTexture.scale`: scales the tangent-space normal's x and y.
+    pub normal_scale: f32,
+    pub alpha: GltfAlphaMode,
+    pub double_sided: bool,
+    /// `KHR_materials_ior`.
+    pub ior: f32,
+    /// `KHR_materials_specular` factor and colour factor.
+    pub specular: f32,
+    pub specular_color: Rgb,
+    /// `KHR_materials_transmission` factor.
+    pub transmission: f32,
+    /// `KHR_materials_volume`: thickness 0 (or no extension) is a thin wall.
+    pub thin_walled: bool,
+    /// `KHR_materials_volume` attenuation colour and distance (infinite: no absorption).
+    pub attenuation_color: Rgb,
+    pub attenuation_distance: f32,
+    /// `KHR_materials_clearcoat` factor and roughness factor.
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
+    /// `KHR_materials_sheen` colour and roughness factors.
+    pub sheen_color: Rgb,
+    pub sheen_roughness: f32,
+    /// `KHR_materials_unlit`: the base colour is emitted, nothing scatters.
+    pub unlit: bool,
+}
+
+impl GltfMaterialDesc {
+    /// The specification's default material (a primitive without one): white, metallic 1,
+    /// roughness 1, single-sided.
+    pub fn default_material() -> GltfMaterialDesc {
+        GltfMaterialDesc {
+            base_color: Rgb::splat(1.0),
+            base_alpha: 1.0,
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            alpha: GltfAlphaMode::Opaque,
+            double_sided: false,
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: Rgb::splat(1.0),
+            transmission: 0.0,
+            thin_walled: true,
+            attenuation_color: Rgb::splat(1.0),
+            attenuation_distance: f32::MAX,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            sheen_color: Rgb::BLACK,
+            sheen_roughness: 0.0,
+            unlit: false,
+        }
+    }
+
+    /// The textures, in a fixed order (base colour, metal/rough, normal).
+    pub fn textures(&self) -> Vec<&super::TextureDesc> {
+        [&self.base_color_texture, &self.metallic_roughness_texture, &self.normal_texture]
+            .into_iter()
+            .flatten()
+            .collect()
+    }
+
+    pub fn textures_mut(&mut self) -> Vec<&mut super::TextureDesc> {
+        [&mut self.base_color_texture, &mut self.metallic_roughness_texture, &mut self.normal_texture]
+            .into_iter()
+            .flatten()
+            .collect()
+    }
+}
