@@ -1,6 +1,6 @@
 //! The light BVH (`LightSelection::Tree`): at random shading points of a scene with many
-//! lights of every bounded kind (spheres, rectangles, one-sided and two-sided meshes,
-//! cylinders, point and spot lights) and infinite ones beside them,
+//! lights of every bounded kind (spheres, rectangles, one-sided and two-sided meshes, disks
+//! whose triangles are leaves of their own, cylinders, point and spot lights) and infinite ones beside them,
 //! - the probabilities of all lights sum to one, and each light the tree samples is given
 //!   exactly the probability `light_pmf_at` recomputes for it (what MIS uses when a
 //!   BSDF-sampled ray hits that light), and the lights are drawn with those probabilities
@@ -18,7 +18,7 @@ use common::stats::{block_estimates, image_estimate, sidak, z_critical, Estimate
 use glint::accel::BvhSplit;
 use glint::assemble::WorldBuilder;
 use glint::integrators::{DirectSettings, Integrator};
-use glint::lights::{AreaEmission, Light, LightSelection};
+use glint::lights::{by_triangle, AreaEmission, Light, LightSelection};
 use glint::materials::Texture;
 use glint::math::{rgb, vec3, Frame, Rgb, Transform, Vec3};
 use glint::sampling::Rng;
@@ -98,6 +98,17 @@ fn many_lights(sky: bool, deltas: bool) -> World {
             }
         }
     }
+    // Two disks (triangle fans: the tree holds each triangle as a leaf), one facing down,
+    // one tilted and two-sided.
+    let disk = std::sync::Arc::new(glint::geometry::disk_mesh(BvhSplit::Sah));
+    let down = Transform::translate(vec3(-1.0, 2.2, 0.5))
+        .then_after(&Transform::rotate(Vec3::X, 90.0))
+        .then_after(&Transform::scale(vec3(0.4, 0.4, 0.4)).unwrap());
+    b.add_mesh_instance(&disk, &down, false, lamp, lit(rgb(3.0, 2.5, 2.0), false), false).unwrap();
+    let tilted = Transform::translate(vec3(1.5, 1.4, -0.8))
+        .then_after(&Transform::rotate(vec3(1.0, 0.0, 1.0), 60.0))
+        .then_after(&Transform::scale(vec3(0.3, 0.3, 0.3)).unwrap());
+    b.add_mesh_instance(&disk, &tilted, false, lamp, lit(rgb(1.0, 2.0, 3.0), true), false).unwrap();
     if sky {
         b.add_constant_environment(Rgb::splat(0.05));
     }
@@ -115,24 +126,36 @@ fn tree_probabilities_sum_to_one_and_match_what_mis_recomputes() {
     let mut failures = Vec::new();
     for k in 0..points {
         let p = vec3(8.0 * rng.next_f32() - 4.0, 2.5 * rng.next_f32(), 8.0 * rng.next_f32() - 4.0);
-        let pmfs: Vec<f32> = (0..n).map(|i| world.light_pmf_at(p, i)).collect();
+        // Every choice: a light, or one triangle of a mesh the tree splits.
+        let choices: Vec<(u32, u32)> = (0..n)
+            .flat_map(|i| match &world.lights()[i as usize] {
+                l @ Light::Mesh { emitter, .. } if by_triangle(l) => {
+                    (0..emitter.triangles.len() as u32).map(|t| (i, t)).collect()
+                }
+                _ => vec![(i, 0)],
+            })
+            .collect();
+        assert!(choices.len() > n as usize + 10, "the disks' triangles are not leaves of their own");
+        let pmfs: Vec<f32> = choices.iter().map(|&(i, t)| world.light_pmf_at(p, i, t)).collect();
         let sum: f64 = pmfs.iter().map(|&x| x as f64).sum();
         if (sum - 1.0).abs() > 1e-5 {
             failures.push(format!("{p:?}: the probabilities sum to {sum}"));
         }
         let draws = 20_000u64;
-        let mut counts = vec![0u64; n as usize + 1];
+        let mut counts = vec![0u64; choices.len() + 1];
         for d in 0..draws {
             let u = (d as f32 + rng.next_f32()) / draws as f32;
             match world.choose_light(p, u) {
-                Some((i, pmf, remapped)) => {
-                    counts[i] += 1;
+                Some(c) => {
+                    let key = (c.index as u32, c.triangle.unwrap_or(0));
+                    let k = choices.iter().position(|&x| x == key).expect("a choice that exists");
+                    counts[k] += 1;
                     // The same product of the same choices: equal to f32 rounding of an f64 product.
-                    if (pmf / pmfs[i] - 1.0).abs() > 1e-6 || !(0.0..1.0).contains(&remapped) {
-                        failures.push(format!("{p:?}: light {i} drawn with {pmf}, recomputed {}", pmfs[i]));
+                    if (c.pmf / pmfs[k] - 1.0).abs() > 1e-6 || !(0.0..1.0).contains(&c.remapped) {
+                        failures.push(format!("{p:?}: {key:?} drawn with {}, recomputed {}", c.pmf, pmfs[k]));
                     }
                 }
-                None => counts[n as usize] += 1,
+                None => counts[choices.len()] += 1,
             }
         }
         let mut expected: Vec<f64> = pmfs.iter().map(|&x| x as f64 * draws as f64).collect();

@@ -53,11 +53,11 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
         for _ in 0..s.emitter_samples {
             // The light and the point on it from one 2D point (see path.rs).
             let u = rng.next_2d();
-            let Some((index, pick_pmf, remapped)) = scene.choose_light(si.p, u[0]) else {
+            let Some(choice) = scene.choose_light(si.p, u[0]) else {
                 continue;
             };
-            let light = &scene.lights[index];
-            let Some(ls) = light.sample_li(si.p, [remapped, u[1]]) else {
+            let pick_pmf = choice.pmf;
+            let Some(ls) = scene.sample_chosen(&choice, si.p, u[1]) else {
                 continue;
             };
             if !(ls.pdf > 0.0) || ls.radiance.is_black() {
@@ -104,10 +104,9 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                 Some(hit) => {
                     let sj = scene.interaction(&ray, &hit);
                     if let Some(li_idx) = sj.light {
-                        let light = &scene.lights[li_idx as usize];
                         let le = scene.emitted(&sj, ray.dir);
                         if !le.is_black() {
-                            let light_pdf = scene.light_pmf_at(si.p, li_idx) * light.pdf_li(si.p, ray.dir, sj.p, sj.ng);
+                            let light_pdf = scene.light_pdf(si.p, li_idx, sj.prim, ray.dir, sj.p, sj.ng);
                             l += weight(light_pdf) * le * through;
                         }
                     }
@@ -124,8 +123,7 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                         if le.is_black() {
                             continue;
                         }
-                        let light_pdf =
-                            scene.light_pmf_at(si.p, li_idx) * light.pdf_li(si.p, ray.dir, ray.origin, ray.dir);
+                        let light_pdf = scene.light_pdf(si.p, li_idx, 0, ray.dir, ray.origin, ray.dir);
                         l += weight(light_pdf) * le * through;
                     }
                     break;

@@ -29,12 +29,12 @@ pub(crate) fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<
         return None;
     }
     let u = rng.next_2d();
-    let (index, pmf, remapped) = scene.choose_light(p, u[0])?;
-    let ls = scene.lights[index].sample_li(p, [remapped, u[1]])?;
+    let choice = scene.choose_light(p, u[0])?;
+    let ls = scene.sample_chosen(&choice, p, u[1])?;
     if !(ls.pdf > 0.0) || ls.radiance.is_black() {
         return None;
     }
-    Some((ls, pmf))
+    Some((ls, choice.pmf))
 }
 
 /// MIS weight of an emitter reached by a sampled direction (`light_pdf`, the density light
@@ -66,9 +66,7 @@ pub(crate) fn add_environment(
         if le.is_black() {
             continue;
         }
-        let w = emitter_weight(strategy, prev, || {
-            scene.light_pmf_at(prev.p, li_idx) * light.pdf_li(prev.p, ray.dir, ray.origin, ray.dir)
-        });
+        let w = emitter_weight(strategy, prev, || scene.light_pdf(prev.p, li_idx, 0, ray.dir, ray.origin, ray.dir));
         *l += throughput * le * w;
     }
 }
@@ -86,12 +84,9 @@ pub(crate) fn add_emitted(
     throughput: Rgb,
     l: &mut Rgb,
 ) {
-    let light = &scene.lights[li_idx as usize];
     let le = scene.emitted(si, ray.dir);
     if !le.is_black() {
-        let w = emitter_weight(strategy, prev, || {
-            scene.light_pmf_at(prev.p, li_idx) * light.pdf_li(prev.p, ray.dir, si.p, si.ng)
-        });
+        let w = emitter_weight(strategy, prev, || scene.light_pdf(prev.p, li_idx, si.prim, ray.dir, si.p, si.ng));
         *l += throughput * le * w;
     }
 }

@@ -29,7 +29,7 @@ pub use envmap::EnvMap;
 pub use projected::{ProjectedKind, ProjectedLight};
 pub use rectangle::Rectangle;
 pub use texel::{RectangleImportance, TexelImportance, UvJacobian, UvRectangle};
-pub use tree::{LightTree, TreeSample};
+pub use tree::{by_triangle, LightTree, TreeSample};
 
 use rectangle::SphericalRectangle;
 use texel::SPHERE_UV_JACOBIAN;
@@ -474,6 +474,33 @@ impl Light {
             Light::EnvMap(env) => env.sample(u),
             Light::Projected(l) => l.sample_li(p),
         }
+    }
+
+    /// Samples a point uniformly on triangle `t` of a mesh light (the light tree chooses the
+    /// triangles of large meshes one by one); `None` for other lights.
+    pub fn sample_li_triangle(&self, p: Vec3, t: usize, u: [f32; 2]) -> Option<LightSample> {
+        let Light::Mesh { emitter, radiance, two_sided, .. } = self else { return None };
+        let [a, b, c] = *emitter.triangles.get(t)?;
+        let bary = warp::uniform_triangle(u);
+        let q = a * (1.0 - bary[0] - bary[1]) + b * bary[0] + c * bary[1];
+        let n = (b - a).cross(c - a);
+        let area = 0.5 * n.length();
+        if !(area > 0.0) {
+            return None;
+        }
+        let le = radiance_at(radiance, || emitter.texture_point(t, bary));
+        area_sample(p, q, n / (2.0 * area), *two_sided, 1.0 / area, le)
+    }
+
+    /// The density of `sample_li_triangle` on triangle `t` from `p` producing `q` (normal `n`).
+    pub fn pdf_li_triangle(&self, p: Vec3, wi: Vec3, q: Vec3, n: Vec3, t: usize) -> f32 {
+        let Light::Mesh { emitter, .. } = self else { return 0.0 };
+        let Some([a, b, c]) = emitter.triangles.get(t) else { return 0.0 };
+        let area = 0.5 * (*b - *a).cross(*c - *a).length();
+        if !(area > 0.0) {
+            return 0.0;
+        }
+        solid_angle_pdf(p, wi, q, n, 1.0 / area)
     }
 
     /// Solid-angle density of `sample_li` from `p` producing the point `q` (normal `n`) on an

@@ -133,6 +133,27 @@ fn minus_clamped(cos_a: f32, sin_a: f32, cos_b: f32, sin_b: f32) -> (f32, f32) {
     (cos_a * cos_b + sin_a * sin_b, (sin_a * cos_b - cos_a * sin_b).max(0.0))
 }
 
+/// Whether the tree holds each triangle of this light as a leaf of its own (meshes other
+/// than a single rectangle, which is sampled as a whole, by solid angle or by its texels).
+pub fn by_triangle(light: &Light) -> bool {
+    matches!(light, Light::Mesh { emitter, .. } if emitter.rectangle.is_none() && emitter.triangles.len() > 1)
+}
+
+/// The bounds of triangle `t` of a mesh light split by triangle.
+fn triangle_bounds(light: &Light, t: usize) -> Option<Bounds> {
+    let Light::Mesh { emitter, radiance, two_sided, .. } = light else { return None };
+    let [a, b, c] = emitter.triangles[t];
+    let n = (b - a).cross(c - a);
+    let area = 0.5 * n.length();
+    let sides = if *two_sided { 2.0 } else { 1.0 };
+    let power = sides * PI * area * radiance.mean().luminance();
+    if !(power > 0.0 && power.is_finite()) {
+        return None;
+    }
+    let normals = Cone { axis: n.normalize(), cos_theta: 1.0 };
+    Some(Bounds { aabb: Aabb::EMPTY.grow(a).grow(b).grow(c), power, normals, cos_theta_e: 0.0, two_sided: *two_sided })
+}
+
 /// The bounds of one light; `None` for infinite lights and lights that emit nothing.
 fn light_bounds(light: &Light) -> Option<Bounds> {
     let power = light.power();
@@ -179,12 +200,18 @@ fn light_bounds(light: &Light) -> Option<Bounds> {
 #[derive(Clone, Debug)]
 struct Node {
     bounds: Bounds,
-    /// Inner node: its children's indices; leaf: `[light, u32::MAX]`.
+    /// Inner node: its children's indices; leaf: `[light, LEAF]`.
     children: [u32; 2],
     parent: u32,
+    /// A leaf's triangle (for a mesh light split by triangle), or `WHOLE`.
+    triangle: u32,
 }
 
+/// A leaf: a light and, for a mesh split by triangle, the triangle.
+type LeafKey = (u32, u32);
+
 const LEAF: u32 = u32::MAX;
+const WHOLE: u32 = u32::MAX;
 const NO_PARENT: u32 = u32::MAX;
 const BINS: usize = 12;
 
@@ -192,18 +219,23 @@ const BINS: usize = 12;
 #[derive(Clone, Debug)]
 pub struct LightTree {
     nodes: Vec<Node>,
-    /// Per light: its leaf, or `None` for lights outside the tree.
+    /// Per light: its leaf, or `None` for lights outside the tree or split by triangle.
     leaf_of: Vec<Option<u32>>,
+    /// Per light split by triangle: where its triangles' leaves start in `triangle_leaves`.
+    first_triangle_leaf: Vec<Option<u32>>,
+    triangle_leaves: Vec<u32>,
     infinite: Vec<u32>,
     /// The probability of each infinite light, and of the tree.
     p_infinite: f32,
     p_tree: f32,
 }
 
-/// The light chosen, its probability and the random number rescaled for reuse.
+/// The light chosen (and its triangle, for a mesh split by triangle: the point is then
+/// sampled on that triangle), its probability and the random number rescaled for reuse.
 #[derive(Clone, Copy, Debug)]
 pub struct TreeSample {
     pub index: usize,
+    pub triangle: Option<u32>,
     pub pmf: f32,
     pub remapped: f32,
 }
@@ -212,20 +244,42 @@ impl LightTree {
     /// `None` when no light can be chosen.
     pub fn new(lights: &[Light]) -> Option<LightTree> {
         let infinite: Vec<u32> = (0..lights.len() as u32).filter(|&i| lights[i as usize].is_infinite()).collect();
-        let leaves: Vec<(u32, Bounds)> =
-            lights.iter().enumerate().filter_map(|(i, l)| light_bounds(l).map(|b| (i as u32, b))).collect();
+        let mut leaves: Vec<(LeafKey, Bounds)> = Vec::new();
+        let mut first_triangle_leaf = vec![None; lights.len()];
+        let mut triangle_count = 0;
+        for (i, l) in lights.iter().enumerate() {
+            if let (true, Light::Mesh { emitter, .. }) = (by_triangle(l), l) {
+                first_triangle_leaf[i] = Some(triangle_count as u32);
+                triangle_count += emitter.triangles.len();
+                for t in 0..emitter.triangles.len() {
+                    leaves.extend(triangle_bounds(l, t).map(|b| ((i as u32, t as u32), b)));
+                }
+            } else if let Some(b) = light_bounds(l) {
+                leaves.push(((i as u32, WHOLE), b));
+            }
+        }
         let mut nodes = Vec::with_capacity(2 * leaves.len());
         let mut leaf_of = vec![None; lights.len()];
+        let mut triangle_leaves = vec![NO_PARENT; triangle_count];
         if !leaves.is_empty() {
-            let mut items = leaves;
-            build(&mut nodes, &mut leaf_of, &mut items, NO_PARENT);
+            let mut slots =
+                LeafSlots { whole: &mut leaf_of, first: &first_triangle_leaf, triangles: &mut triangle_leaves };
+            build(&mut nodes, &mut slots, &mut leaves, NO_PARENT);
         }
         let parts = infinite.len() + usize::from(!nodes.is_empty());
         if parts == 0 {
             return None;
         }
         let p = 1.0 / parts as f32;
-        Some(LightTree { p_tree: if nodes.is_empty() { 0.0 } else { p }, nodes, leaf_of, infinite, p_infinite: p })
+        Some(LightTree {
+            p_tree: if nodes.is_empty() { 0.0 } else { p },
+            nodes,
+            leaf_of,
+            first_triangle_leaf,
+            triangle_leaves,
+            infinite,
+            p_infinite: p,
+        })
     }
 
     /// A light for the point `p`, chosen with `u`; `None` where no light can reach `p`.
@@ -236,7 +290,12 @@ impl LightTree {
             let k = (u / self.p_infinite) as usize;
             if k < self.infinite.len() {
                 let remapped = (u / self.p_infinite - k as f32).clamp(0.0, 0.999_999_94);
-                return Some(TreeSample { index: self.infinite[k] as usize, pmf: self.p_infinite, remapped });
+                return Some(TreeSample {
+                    index: self.infinite[k] as usize,
+                    triangle: None,
+                    pmf: self.p_infinite,
+                    remapped,
+                });
             }
             if self.nodes.is_empty() {
                 return None;
@@ -249,7 +308,8 @@ impl LightTree {
         loop {
             let n = &self.nodes[node];
             if n.children[1] == LEAF {
-                return Some(TreeSample { index: n.children[0] as usize, pmf: pmf as f32, remapped: u });
+                let triangle = (n.triangle != WHOLE).then_some(n.triangle);
+                return Some(TreeSample { index: n.children[0] as usize, triangle, pmf: pmf as f32, remapped: u });
             }
             let [l, r] = n.children.map(|c| c as usize);
             let p_left = choice(self.nodes[l].bounds.importance(p), self.nodes[r].bounds.importance(p))?;
@@ -265,9 +325,14 @@ impl LightTree {
         }
     }
 
-    /// The probability that [`LightTree::sample`] at `p` chooses light `i`.
-    pub fn pmf(&self, p: Vec3, i: u32) -> f32 {
-        let Some(leaf) = self.leaf_of.get(i as usize).copied().flatten() else {
+    /// The probability that [`LightTree::sample`] at `p` chooses light `i` (its triangle
+    /// `triangle`, for a mesh split by triangle; ignored for other lights).
+    pub fn pmf(&self, p: Vec3, i: u32, triangle: u32) -> f32 {
+        let leaf = match self.first_triangle_leaf.get(i as usize).copied().flatten() {
+            Some(first) => self.triangle_leaves.get((first + triangle) as usize).copied().filter(|&l| l != NO_PARENT),
+            None => self.leaf_of.get(i as usize).copied().flatten(),
+        };
+        let Some(leaf) = leaf else {
             return if self.infinite.contains(&i) { self.p_infinite } else { 0.0 };
         };
         let mut pmf = self.p_tree as f64;
@@ -284,9 +349,9 @@ impl LightTree {
         pmf as f32
     }
 
-    /// The number of lights the tree holds (for tests).
-    pub fn bounded_lights(&self) -> usize {
-        self.leaf_of.iter().filter(|l| l.is_some()).count()
+    /// Whether light `i`'s triangles are leaves of their own.
+    pub fn splits(&self, i: u32) -> bool {
+        self.first_triangle_leaf.get(i as usize).is_some_and(|f| f.is_some())
     }
 }
 
@@ -297,20 +362,30 @@ fn choice(left: f32, right: f32) -> Option<f32> {
     (total > 0.0).then(|| left / total)
 }
 
+/// Where the build records each leaf's node.
+struct LeafSlots<'a> {
+    whole: &'a mut [Option<u32>],
+    first: &'a [Option<u32>],
+    triangles: &'a mut [u32],
+}
+
 /// Builds the subtree over `items` at the end of `nodes`; returns its index.
-fn build(nodes: &mut Vec<Node>, leaf_of: &mut [Option<u32>], items: &mut [(u32, Bounds)], parent: u32) -> u32 {
+fn build(nodes: &mut Vec<Node>, slots: &mut LeafSlots, items: &mut [(LeafKey, Bounds)], parent: u32) -> u32 {
     let index = nodes.len() as u32;
-    if let [(light, b)] = items {
-        nodes.push(Node { bounds: *b, children: [*light, LEAF], parent });
-        leaf_of[*light as usize] = Some(index);
+    if let [((light, triangle), b)] = items {
+        nodes.push(Node { bounds: *b, children: [*light, LEAF], parent, triangle: *triangle });
+        match slots.first[*light as usize] {
+            Some(first) => slots.triangles[(first + *triangle) as usize] = index,
+            None => slots.whole[*light as usize] = Some(index),
+        }
         return index;
     }
     let all = items.iter().fold(items[0].1, |acc, (_, b)| Bounds::union(&acc, b));
-    nodes.push(Node { bounds: all, children: [0, 0], parent });
+    nodes.push(Node { bounds: all, children: [0, 0], parent, triangle: WHOLE });
     let mid = split(items, &all);
     let (left, right) = items.split_at_mut(mid);
-    let l = build(nodes, leaf_of, left, index);
-    let r = build(nodes, leaf_of, right, index);
+    let l = build(nodes, slots, left, index);
+    let r = build(nodes, slots, right, index);
     nodes[index as usize].children = [l, r];
     index
 }
@@ -318,7 +393,7 @@ fn build(nodes: &mut Vec<Node>, leaf_of: &mut [Option<u32>], items: &mut [(u32, 
 /// Sorts `items` so that the best split is at the returned index (1..len): binned centroids
 /// along each axis, cost by power × orientation measure × surface area (pbrt-v4's
 /// light-bounds cost); the middle of the longest axis's order when nothing separates them.
-fn split(items: &mut [(u32, Bounds)], all: &Bounds) -> usize {
+fn split(items: &mut [(LeafKey, Bounds)], all: &Bounds) -> usize {
     let centroid = |b: &Bounds| (b.aabb.min + b.aabb.max) * 0.5;
     let cb = items.iter().fold(Aabb::EMPTY, |a, (_, b)| {
         let c = centroid(b);
@@ -381,7 +456,7 @@ fn split(items: &mut [(u32, Bounds)], all: &Bounds) -> usize {
 
 /// Moves the items for which `left` holds to the front, keeping each side's order; returns
 /// their count.
-fn partition(items: &mut [(u32, Bounds)], left: impl Fn(&Bounds) -> bool) -> usize {
+fn partition(items: &mut [(LeafKey, Bounds)], left: impl Fn(&Bounds) -> bool) -> usize {
     let (l, r): (Vec<_>, Vec<_>) = items.iter().copied().partition(|(_, b)| left(b));
     let n = l.len();
     for (slot, item) in items.iter_mut().zip(l.into_iter().chain(r)) {

@@ -10,7 +10,7 @@
 use crate::accel::{prefetch, BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{CurveHit, Curves, Cylinder, SdfGrid, Sphere, TriangleMesh};
-use crate::lights::{Light, LightSelection, LightTree};
+use crate::lights::{Light, LightSample, LightSelection, LightTree};
 use crate::materials::{Material, MaterialKind, TexturePoint};
 use crate::math::{Aabb, Frame, Ray, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
@@ -89,6 +89,17 @@ pub struct SurfaceInteraction {
     /// per-vertex and per-face mesh attributes.
     pub prim: u32,
     pub bary: [f32; 2],
+}
+
+/// A light chosen for next-event estimation: its index, its triangle (where the light tree
+/// chooses a mesh's triangles one by one), its probability, and the random number rescaled
+/// within its share (for the point on the light).
+#[derive(Clone, Copy, Debug)]
+pub struct LightChoice {
+    pub index: usize,
+    pub triangle: Option<u32>,
+    pub pmf: f32,
+    pub remapped: f32,
 }
 
 pub struct World {
@@ -227,26 +238,49 @@ impl World {
         self.light_distribution.as_ref().map_or(0.0, |d| d.pmf(i as usize))
     }
 
-    /// Probability of choosing light `i` for next-event estimation at `p`.
+    /// Probability of choosing light `i` (its triangle `triangle`, where the light tree
+    /// chooses a mesh's triangles one by one) for next-event estimation at `p`.
     #[inline]
-    pub fn light_pmf_at(&self, p: Vec3, i: u32) -> f32 {
+    pub fn light_pmf_at(&self, p: Vec3, i: u32, triangle: u32) -> f32 {
         match &self.light_tree {
-            Some(tree) => tree.pmf(p, i),
+            Some(tree) => tree.pmf(p, i, triangle),
             None => self.light_pmf(i),
         }
     }
 
-    /// Chooses a light for next-event estimation at `p` with `u`: its index, its probability
-    /// and `u` rescaled within its share (for the point on the light). `None` without lights,
-    /// or where the tree finds that none reaches `p`.
+    /// The density with which next-event estimation at `p` reaches the point `q` (normal `n`,
+    /// primitive `prim`) of light `li` along `wi`: the probability of choosing the light
+    /// times the light's own density. What MIS weighs a BSDF-sampled ray that hit it by.
     #[inline]
-    pub fn choose_light(&self, p: Vec3, u: f32) -> Option<(usize, f32, f32)> {
+    pub fn light_pdf(&self, p: Vec3, li: u32, prim: u32, wi: Vec3, q: Vec3, n: Vec3) -> f32 {
+        let light = &self.lights[li as usize];
+        match &self.light_tree {
+            Some(tree) if tree.splits(li) => tree.pmf(p, li, prim) * light.pdf_li_triangle(p, wi, q, n, prim as usize),
+            Some(tree) => tree.pmf(p, li, prim) * light.pdf_li(p, wi, q, n),
+            None => self.light_pmf(li) * light.pdf_li(p, wi, q, n),
+        }
+    }
+
+    /// Chooses a light for next-event estimation at `p` with `u`; `None` without lights, or
+    /// where the tree finds that none reaches `p`.
+    #[inline]
+    pub fn choose_light(&self, p: Vec3, u: f32) -> Option<LightChoice> {
         if let Some(tree) = &self.light_tree {
             let s = tree.sample(p, u)?;
-            return Some((s.index, s.pmf, s.remapped));
+            return Some(LightChoice { index: s.index, triangle: s.triangle, pmf: s.pmf, remapped: s.remapped });
         }
         let pick = self.light_distribution.as_ref()?.sample(u);
-        Some((pick.index, pick.pmf, pick.remapped))
+        Some(LightChoice { index: pick.index, triangle: None, pmf: pick.pmf, remapped: pick.remapped })
+    }
+
+    /// Samples the chosen light from `p`, with `u[0]` replaced by the choice's rescaled one.
+    #[inline]
+    pub fn sample_chosen(&self, c: &LightChoice, p: Vec3, u1: f32) -> Option<LightSample> {
+        let light = &self.lights[c.index];
+        match c.triangle {
+            Some(t) => light.sample_li_triangle(p, t as usize, [c.remapped, u1]),
+            None => light.sample_li(p, [c.remapped, u1]),
+        }
     }
 
     /// Whether next-event estimation has any light to choose.
