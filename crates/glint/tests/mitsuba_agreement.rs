@@ -42,6 +42,29 @@ fn render_at(name: &str, spp: u64) -> Image {
     render(&scene.world, &scene.integrator, &scene.settings, &Silent).image
 }
 
+/// As `check`, with the light selection set to `selection` (the session's override, as the
+/// command line's `--light-selection` sets it).
+fn check_with_selection(name: &str, selection: glint::lights::LightSelection) -> f64 {
+    use glint::formats::ReadOptions;
+    use glint::session::Session;
+    let entry = reference_entry(name);
+    let mitsuba_rel_mse = entry["mitsuba_rel_mse"].as_f64().unwrap();
+    let mut session = Session::open(&dir().join(format!("{name}.xml")), &ReadOptions::default()).unwrap();
+    session.edit().light_selection = selection;
+    let world = session.world().unwrap();
+    let mut settings = session.render_settings();
+    settings.spp = entry["test_spp"].as_u64().unwrap() as u32;
+    let image = render(&world, &session.integrator(), &settings, &Silent).image;
+    let reference = read_image(&dir().join(format!("references/{name}.exr"))).unwrap();
+    let (ours, theirs) = (image.channel_means(), reference.channel_means());
+    let err = rel_mse(&image, &reference);
+    eprintln!(
+        "{name} ({selection:?}): means {ours:?} vs {theirs:?}; relMSE {err:.3e} vs Mitsuba's {mitsuba_rel_mse:.3e}"
+    );
+    assert_means_agree(name, ours, theirs, 0.01);
+    err / mitsuba_rel_mse
+}
+
 /// Criterion (a): every channel mean within `tolerance` (relative) of Mitsuba's.
 fn assert_means_agree(name: &str, ours: [f64; 3], theirs: [f64; 3], tolerance: f64) {
     for k in 0..3 {
@@ -309,6 +332,18 @@ fn textured_area_emitters_and_an_emitting_cylinder() {
 #[test]
 fn rectangle_light_with_an_hdr_bitmap() {
     check_against("area-hdr-panel", 0.01, 1.0);
+}
+
+/// 400 sphere lights of radiance spanning 100x, rendered with the light tree: means within 1%
+/// and relative MSE at most 1.3x Mitsuba's (which picks lights uniformly); power selection,
+/// the default, is held to the same.
+#[test]
+fn many_sphere_lights_by_the_tree_and_by_power() {
+    use glint::lights::LightSelection;
+    for selection in [LightSelection::Tree, LightSelection::Power] {
+        let ratio = check_with_selection("many-spheres", selection);
+        assert!(ratio <= 1.3, "many-spheres ({selection:?}): relative MSE {ratio:.2}x Mitsuba's");
+    }
 }
 
 /// A large light whose bitmap is a few bright texels on a dim ground (46.8x Mitsuba's error
