@@ -108,12 +108,63 @@ fn many_lights(sky: bool, deltas: bool) -> World {
     let tilted = Transform::translate(vec3(1.5, 1.4, -0.8))
         .then_after(&Transform::rotate(vec3(1.0, 0.0, 1.0), 60.0))
         .then_after(&Transform::scale(vec3(0.3, 0.3, 0.3)).unwrap());
-    b.add_mesh_instance(&disk, &tilted, false, lamp, lit(rgb(1.0, 2.0, 3.0), true), false).unwrap();
+    // Textured, in a checker of 150x contrast: the tree weighs each triangle by the texture
+    // read over it (a floor keeps every triangle's probability above zero).
+    let checker = Texture::Checkerboard {
+        color0: rgb(0.02, 0.04, 0.06),
+        color1: rgb(3.0, 2.0, 1.0),
+        uv_scale: [3.0, 3.0],
+        uv_offset: [0.0, 0.0],
+    };
+    let textured = Some(AreaEmission { radiance: checker, two_sided: true });
+    b.add_mesh_instance(&disk, &tilted, false, lamp, textured, false).unwrap();
     if sky {
         b.add_constant_environment(Rgb::splat(0.05));
     }
     let cam = camera(vec3(0.0, 5.0, 5.5), vec3(0.0, 0.0, 0.0), Vec3::Y, 60.0, 32, 32);
     b.finish(cam, LightSelection::Tree).unwrap()
+}
+
+/// `LightSelection::Auto` (the default) is the tree where the choice depends on the shading
+/// point, and power where there is one bounded light of constant radiance.
+#[test]
+fn auto_selection_is_the_tree_where_it_has_something_to_choose_by() {
+    let disk = std::sync::Arc::new(glint::geometry::disk_mesh(BvhSplit::Sah));
+    let world = |lights: &[&str]| {
+        let mut b = WorldBuilder::new(BvhSplit::Sah);
+        let lamp = b.black_material();
+        for (k, which) in lights.iter().enumerate() {
+            let at = Transform::translate(vec3(k as f32, 1.0, 0.0));
+            match *which {
+                "sphere" => {
+                    b.add_sphere(vec3(k as f32, 1.0, 0.0), 0.1, &Transform::IDENTITY, lamp, lit(Rgb::WHITE, false), false)
+                        .unwrap();
+                }
+                "disk" => {
+                    b.add_mesh_instance(&disk, &at, false, lamp, lit(Rgb::WHITE, false), false).unwrap();
+                }
+                "textured disk" => {
+                    let radiance = Texture::Checkerboard {
+                        color0: Rgb::WHITE,
+                        color1: Rgb::splat(2.0),
+                        uv_scale: [1.0, 1.0],
+                        uv_offset: [0.0, 0.0],
+                    };
+                    let emission = Some(AreaEmission { radiance, two_sided: false });
+                    b.add_mesh_instance(&disk, &at, false, lamp, emission, false).unwrap();
+                }
+                "sky" => b.add_constant_environment(Rgb::splat(0.1)),
+                other => panic!("no such light {other}"),
+            }
+        }
+        let cam = camera(vec3(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 40.0, 4, 4);
+        b.finish(cam, LightSelection::Auto).unwrap().light_selection()
+    };
+    assert_eq!(world(&["disk"]), LightSelection::Power);
+    assert_eq!(world(&["sphere", "sky"]), LightSelection::Power);
+    assert_eq!(world(&["sphere", "sphere"]), LightSelection::Tree);
+    assert_eq!(world(&["disk", "sphere", "sky"]), LightSelection::Tree);
+    assert_eq!(world(&["textured disk"]), LightSelection::Tree);
 }
 
 #[test]

@@ -572,7 +572,7 @@ impl SceneDesc {
             film,
             integrator: IntegratorDesc::Path(PathSettings::default()),
             sampler: SamplerDesc::default(),
-            light_selection: LightSelection::Power,
+            light_selection: LightSelection::Auto,
             materials: Vec::new(),
             meshes: Vec::new(),
             shapes: Vec::new(),

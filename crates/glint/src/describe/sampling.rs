@@ -43,11 +43,15 @@ pub enum LightSelection {
     /// Proportional to emitted power among bounded lights; each infinite light (sky,
     /// environment map, directional) is chosen as often as all bounded lights together; half
     /// of the choices are made so, the other half uniformly (see `World::POWER_SHARE`).
-    #[default]
     Power,
     /// By a light BVH, from each shading point, in proportion to a bound of what each group
     /// of lights sends there (`lights::LightTree`).
     Tree,
+    /// `Tree` where the choice depends on where the shading point is (two or more bounded
+    /// lights, or a mesh light whose radiance varies over its triangles), else `Power` (one
+    /// bounded light, with or without infinite ones: the tree has nothing to choose by).
+    #[default]
+    Auto,
 }
 
 impl std::str::FromStr for LightSelection {
@@ -58,7 +62,8 @@ impl std::str::FromStr for LightSelection {
             "area" => Ok(LightSelection::Area),
             "power" => Ok(LightSelection::Power),
             "tree" => Ok(LightSelection::Tree),
-            _ => Err(format!("unknown light selection '{s}' (expected uniform, area, power or tree)")),
+            "auto" => Ok(LightSelection::Auto),
+            _ => Err(format!("unknown light selection '{s}' (expected auto, tree, power, uniform or area)")),
         }
     }
 }

@@ -18,6 +18,7 @@
 //! checkpoints and distributed workers see the same tree.
 
 use super::Light;
+use crate::materials::Texture;
 use crate::math::{Aabb, Vec3, PI};
 
 /// A cone of directions: `axis` and the cosine of its half-angle (-1: every direction).
@@ -34,6 +35,24 @@ impl Cone {
     fn union(a: Cone, b: Cone) -> Cone {
         if a.cos_theta <= -1.0 || b.cos_theta <= -1.0 {
             return Cone::ALL;
+        }
+        // Most unions in a build are of a cone with one it already holds (the triangles of
+        // a flat panel): tell those by cosines alone, leaving the borderline (by a margin
+        // far above rounding) to the exact path below, which returns the same cone there.
+        let cos_d = a.axis.dot(b.axis).clamp(-1.0, 1.0);
+        let sin_d = (1.0 - cos_d * cos_d).max(0.0).sqrt();
+        let holds = |outer: Cone, inner: Cone| {
+            let sin_i = (1.0 - inner.cos_theta * inner.cos_theta).max(0.0).sqrt();
+            // cos and sin of θd + θinner: within π and inside the outer cone's angle.
+            let cos_sum = cos_d * inner.cos_theta - sin_d * sin_i;
+            let sin_sum = sin_d * inner.cos_theta + cos_d * sin_i;
+            sin_sum >= 0.0 && cos_sum >= outer.cos_theta + 1e-5
+        };
+        if holds(a, b) {
+            return a;
+        }
+        if holds(b, a) {
+            return b;
         }
         let (ta, tb) = (a.cos_theta.clamp(-1.0, 1.0).acos(), b.cos_theta.clamp(-1.0, 1.0).acos());
         let td = a.axis.dot(b.axis).clamp(-1.0, 1.0).acos();
@@ -87,21 +106,52 @@ impl Bounds {
             two_sided: a.two_sided || b.two_sided,
         }
     }
+}
+
+/// A node's bounds in the form [`Importance::at`] reads: what `Bounds` gives, with the parts
+/// that do not depend on the shading point (centre, half diagonal, the cone's sine) worked
+/// out once at build time by the same operations as before, so the values are the same bits.
+#[derive(Clone, Copy, Debug)]
+struct Importance {
+    center: Vec3,
+    half_diag: f32,
+    axis: Vec3,
+    cos_o: f32,
+    sin_o: f32,
+    cos_theta_e: f32,
+    power: f32,
+    two_sided: bool,
+}
+
+impl Importance {
+    fn new(b: &Bounds) -> Importance {
+        let cos_o = b.normals.cos_theta;
+        Importance {
+            center: b.aabb.center(),
+            half_diag: (b.aabb.max - b.aabb.min).length() * 0.5,
+            axis: b.normals.axis,
+            cos_o,
+            sin_o: (1.0 - cos_o * cos_o).max(0.0).sqrt(),
+            cos_theta_e: b.cos_theta_e,
+            power: b.power,
+            two_sided: b.two_sided,
+        }
+    }
 
     /// An upper bound (up to a constant) of what the lights send to `p`.
-    fn importance(&self, p: Vec3) -> f32 {
+    #[inline]
+    fn at(&self, p: Vec3) -> f32 {
         if self.power == 0.0 {
             return 0.0;
         }
-        let center = self.aabb.center();
-        let half_diag = (self.aabb.max - self.aabb.min).length() * 0.5;
-        let d = p - center;
+        let half_diag = self.half_diag;
+        let d = p - self.center;
         let dist2 = d.length_squared().max(half_diag * half_diag);
         // The cone's angle to the direction towards p, less its own half-angle and the angle
         // the box subtends from p: the smallest angle any light's normal can make with p.
         let dist = d.length();
-        let wi = if dist > 0.0 { d / dist } else { self.normals.axis };
-        let mut cos_w = self.normals.axis.dot(wi);
+        let wi = if dist > 0.0 { d / dist } else { self.axis };
+        let mut cos_w = self.axis.dot(wi);
         if self.two_sided {
             cos_w = cos_w.abs();
         }
@@ -112,10 +162,8 @@ impl Bounds {
             let s = half_diag / dist;
             ((1.0 - s * s).max(0.0).sqrt(), s)
         };
-        let cos_o = self.normals.cos_theta;
-        let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
         // cos(max(0, θw - θo)) then cos(max(0, that - θb)).
-        let (cos_x, sin_x) = minus_clamped(cos_w, sin_w, cos_o, sin_o);
+        let (cos_x, sin_x) = minus_clamped(cos_w, sin_w, self.cos_o, self.sin_o);
         let (cos_p, _) = minus_clamped(cos_x, sin_x, cos_b, sin_b);
         if cos_p <= self.cos_theta_e {
             return 0.0;
@@ -146,12 +194,56 @@ fn triangle_bounds(light: &Light, t: usize) -> Option<Bounds> {
     let n = (b - a).cross(c - a);
     let area = 0.5 * n.length();
     let sides = if *two_sided { 2.0 } else { 1.0 };
-    let power = sides * PI * area * radiance.mean().luminance();
+    let luminance = match radiance {
+        Texture::Constant(c) => c.luminance(),
+        _ => textured_luminance(emitter, radiance, t),
+    };
+    let power = sides * PI * area * luminance;
     if !(power > 0.0 && power.is_finite()) {
         return None;
     }
     let normals = Cone { axis: n.normalize(), cos_theta: 1.0 };
     Some(Bounds { aabb: Aabb::EMPTY.grow(a).grow(b).grow(c), power, normals, cos_theta_e: 0.0, two_sided: *two_sided })
+}
+
+/// Barycentric points spread over a triangle (the centroids of its 16 sub-triangles after
+/// two rounds of midpoint subdivision, then its corners), where a textured triangle's
+/// radiance is read for its power.
+const TRIANGLE_READS: [[f32; 2]; 19] = {
+    let mut points = [[0.0f32; 2]; 19];
+    // Sub-triangle (i, j) of a 4 x 4 grid in barycentric coordinates: upward ones have
+    // centroid ((i + 1/3), (j + 1/3)) / 4, downward ones ((i + 2/3), (j + 2/3)) / 4.
+    let mut k = 0;
+    let mut i = 0;
+    while i < 4 {
+        let mut j = 0;
+        while i + j < 4 {
+            points[k] = [(i as f32 + 1.0 / 3.0) / 4.0, (j as f32 + 1.0 / 3.0) / 4.0];
+            k += 1;
+            if i + j < 3 {
+                points[k] = [(i as f32 + 2.0 / 3.0) / 4.0, (j as f32 + 2.0 / 3.0) / 4.0];
+                k += 1;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    points[16] = [0.0, 0.0];
+    points[17] = [1.0, 0.0];
+    points[18] = [0.0, 1.0];
+    points
+};
+
+/// The luminance of a textured mesh light over triangle `t`, for the tree's importance: the
+/// mean of the texture read at [`TRIANGLE_READS`] (as a hit there reads it), but at least a
+/// thousandth of the texture's mean, so that a triangle whose reads miss a small bright
+/// region is still chosen now and then. Only the choice of triangle depends on it; the
+/// probabilities are exact whatever it says.
+fn textured_luminance(emitter: &super::MeshEmitter, radiance: &Texture, t: usize) -> f32 {
+    let sum: f32 = TRIANGLE_READS.iter().map(|&e| radiance.eval_at(&emitter.texture_point(t, e)).luminance().max(0.0)).sum();
+    let mean = sum / TRIANGLE_READS.len() as f32;
+    let floor = 1e-3 * radiance.mean().luminance().max(0.0);
+    if mean.is_finite() { mean.max(floor) } else { floor }
 }
 
 /// The bounds of one light; `None` for infinite lights and lights that emit nothing.
@@ -199,7 +291,7 @@ fn light_bounds(light: &Light) -> Option<Bounds> {
 
 #[derive(Clone, Debug)]
 struct Node {
-    bounds: Bounds,
+    bounds: Importance,
     /// Inner node: its children's indices; leaf: `[light, LEAF]`.
     children: [u32; 2],
     parent: u32,
@@ -312,7 +404,7 @@ impl LightTree {
                 return Some(TreeSample { index: n.children[0] as usize, triangle, pmf: pmf as f32, remapped: u });
             }
             let [l, r] = n.children.map(|c| c as usize);
-            let p_left = choice(self.nodes[l].bounds.importance(p), self.nodes[r].bounds.importance(p))?;
+            let p_left = choice(self.nodes[l].bounds.at(p), self.nodes[r].bounds.at(p))?;
             if u < p_left {
                 u = (u / p_left).min(0.999_999_94);
                 pmf *= p_left as f64;
@@ -340,7 +432,7 @@ impl LightTree {
         while self.nodes[node].parent != NO_PARENT {
             let parent = self.nodes[node].parent as usize;
             let [l, r] = self.nodes[parent].children.map(|c| c as usize);
-            let Some(p_left) = choice(self.nodes[l].bounds.importance(p), self.nodes[r].bounds.importance(p)) else {
+            let Some(p_left) = choice(self.nodes[l].bounds.at(p), self.nodes[r].bounds.at(p)) else {
                 return 0.0;
             };
             pmf *= if node == l { p_left } else { 1.0 - p_left } as f64;
@@ -373,7 +465,7 @@ struct LeafSlots<'a> {
 fn build(nodes: &mut Vec<Node>, slots: &mut LeafSlots, items: &mut [(LeafKey, Bounds)], parent: u32) -> u32 {
     let index = nodes.len() as u32;
     if let [((light, triangle), b)] = items {
-        nodes.push(Node { bounds: *b, children: [*light, LEAF], parent, triangle: *triangle });
+        nodes.push(Node { bounds: Importance::new(b), children: [*light, LEAF], parent, triangle: *triangle });
         match slots.first[*light as usize] {
             Some(first) => slots.triangles[(first + *triangle) as usize] = index,
             None => slots.whole[*light as usize] = Some(index),
@@ -381,7 +473,7 @@ fn build(nodes: &mut Vec<Node>, slots: &mut LeafSlots, items: &mut [(LeafKey, Bo
         return index;
     }
     let all = items.iter().fold(items[0].1, |acc, (_, b)| Bounds::union(&acc, b));
-    nodes.push(Node { bounds: all, children: [0, 0], parent, triangle: WHOLE });
+    nodes.push(Node { bounds: Importance::new(&all), children: [0, 0], parent, triangle: WHOLE });
     let mid = split(items, &all);
     let (left, right) = items.split_at_mut(mid);
     let l = build(nodes, slots, left, index);
@@ -415,16 +507,22 @@ fn split(items: &mut [(LeafKey, Bounds)], all: &Bounds) -> usize {
         // Extent ratio: splits across a long box are cheaper than across a thin one.
         let full = all.aabb.max - all.aabb.min;
         let k_r = full.x.max(full.y).max(full.z) / full[axis].max(1e-20);
+        // The bounds of bins [0, cut) and [cut, BINS) for every cut, in one sweep each way.
+        let merge = |acc: Option<Bounds>, b: &Option<Bounds>| match (acc, b) {
+            (Some(a), Some(b)) => Some(Bounds::union(&a, b)),
+            (a, b) => a.or(*b),
+        };
+        let mut below: [Option<Bounds>; BINS] = [None; BINS];
         for cut in 1..BINS {
-            let side = |r: std::ops::Range<usize>| {
-                bins[r]
-                    .iter()
-                    .flatten()
-                    .fold(None, |acc: Option<Bounds>, b| Some(acc.map_or(*b, |a| Bounds::union(&a, b))))
-            };
-            let (Some(l), Some(r)) = (side(0..cut), side(cut..BINS)) else { continue };
+            below[cut] = merge(below[cut - 1], &bins[cut - 1]);
+        }
+        let mut above: Option<Bounds> = None;
+        for cut in (1..BINS).rev() {
+            above = merge(above, &bins[cut]);
+            let (Some(l), Some(r)) = (below[cut], above) else { continue };
             let cost = k_r * (cost_of(&l) + cost_of(&r));
-            if best.is_none_or(|(c, _, _)| cost < c) {
+            // Ties go to the lower cut, as when the cuts were tried in increasing order.
+            if best.is_none_or(|(c, a, _)| cost < c || (cost == c && a == axis)) {
                 best = Some((cost, axis, lo + span * cut as f32 / BINS as f32));
             }
         }

@@ -10,8 +10,8 @@
 use crate::accel::{prefetch, BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{CurveHit, Curves, Cylinder, SdfGrid, Sphere, TriangleMesh};
-use crate::lights::{Light, LightSample, LightSelection, LightTree};
-use crate::materials::{Material, MaterialKind, TexturePoint};
+use crate::lights::{self, Light, LightSample, LightSelection, LightTree};
+use crate::materials::{Material, MaterialKind, Texture, TexturePoint};
 use crate::math::{Aabb, Frame, Ray, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
 use crate::sampling::Distribution1d;
@@ -182,10 +182,30 @@ impl World {
     /// rest are uniform.
     pub const POWER_SHARE: f32 = 0.5;
 
+    /// What `LightSelection::Auto` means for this scene's lights (see its doc): the tree
+    /// where it has something to choose by. Measured in BENCHMARKS.md ("Light selection"):
+    /// the tree's error is a quarter to a half of power's on many separate lights and on
+    /// textured emitting meshes, while on one mesh light of constant radiance (where power
+    /// already picks triangles by area, in proportion to what they emit) it only adds its
+    /// traversal.
+    pub fn auto_light_selection(lights: &[Light]) -> LightSelection {
+        let bounded = lights.iter().filter(|l| !l.is_infinite() && l.power() > 0.0).count();
+        let varying_mesh = lights.iter().any(|l| {
+            matches!(l, Light::Mesh { radiance, .. } if !matches!(radiance, Texture::Constant(_))) && lights::by_triangle(l)
+        });
+        if bounded >= 2 || varying_mesh {
+            LightSelection::Tree
+        } else {
+            LightSelection::Power
+        }
+    }
+
     pub fn set_light_selection(&mut self, selection: LightSelection) {
         self.light_selection = selection;
         self.light_tree = None;
         let weights: Vec<f32> = match selection {
+            // Resolved here, so that `light_selection()` says which one runs.
+            LightSelection::Auto => return self.set_light_selection(Self::auto_light_selection(&self.lights)),
             LightSelection::Tree => {
                 self.light_tree = LightTree::new(&self.lights);
                 self.light_distribution = None;
