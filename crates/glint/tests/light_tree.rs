@@ -125,8 +125,8 @@ fn many_lights(sky: bool, deltas: bool) -> World {
     b.finish(cam, LightSelection::Tree).unwrap()
 }
 
-/// `LightSelection::Auto` (the default) is the tree where the choice depends on the shading
-/// point, and power where there is one bounded light of constant radiance.
+/// `LightSelection::Auto` is the tree on a textured emitting mesh and with many lights, and
+/// power otherwise.
 #[test]
 fn auto_selection_is_the_tree_where_it_has_something_to_choose_by() {
     let disk = std::sync::Arc::new(glint::geometry::disk_mesh(BvhSplit::Sah));
@@ -162,8 +162,10 @@ fn auto_selection_is_the_tree_where_it_has_something_to_choose_by() {
     };
     assert_eq!(world(&["disk"]), LightSelection::Power);
     assert_eq!(world(&["sphere", "sky"]), LightSelection::Power);
-    assert_eq!(world(&["sphere", "sphere"]), LightSelection::Tree);
-    assert_eq!(world(&["disk", "sphere", "sky"]), LightSelection::Tree);
+    assert_eq!(world(&["sphere", "sphere", "disk"]), LightSelection::Power);
+    let many = vec!["sphere"; World::AUTO_TREE_LIGHTS];
+    assert_eq!(world(&many), LightSelection::Tree);
+    assert_eq!(world(&many[1..]), LightSelection::Power);
     assert_eq!(world(&["textured disk"]), LightSelection::Tree);
 }
 

@@ -572,7 +572,7 @@ impl SceneDesc {
             film,
             integrator: IntegratorDesc::Path(PathSettings::default()),
             sampler: SamplerDesc::default(),
-            light_selection: LightSelection::Auto,
+            light_selection: LightSelection::Power,
             materials: Vec::new(),
             meshes: Vec::new(),
             shapes: Vec::new(),

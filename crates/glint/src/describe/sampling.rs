@@ -43,14 +43,15 @@ pub enum LightSelection {
     /// Proportional to emitted power among bounded lights; each infinite light (sky,
     /// environment map, directional) is chosen as often as all bounded lights together; half
     /// of the choices are made so, the other half uniformly (see `World::POWER_SHARE`).
+    #[default]
     Power,
     /// By a light BVH, from each shading point, in proportion to a bound of what each group
     /// of lights sends there (`lights::LightTree`).
     Tree,
-    /// `Tree` where the choice depends on where the shading point is (two or more bounded
-    /// lights, or a mesh light whose radiance varies over its triangles), else `Power` (one
-    /// bounded light, with or without infinite ones: the tree has nothing to choose by).
-    #[default]
+    /// `Tree` where it was measured to win (`World::AUTO_TREE_LIGHTS` or more bounded lights,
+    /// or a mesh light whose radiance varies over its triangles), else `Power`. Not the
+    /// default: with a few lights the tree's error was higher than power's on 8 of 9 of
+    /// Mitsuba's documentation scenes it would change (BENCHMARKS.md, "Light selection").
     Auto,
 }
 

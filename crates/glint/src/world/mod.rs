@@ -182,18 +182,19 @@ impl World {
     /// rest are uniform.
     pub const POWER_SHARE: f32 = 0.5;
 
-    /// What `LightSelection::Auto` means for this scene's lights (see its doc): the tree
-    /// where it has something to choose by. Measured in BENCHMARKS.md ("Light selection"):
-    /// the tree's error is a quarter to a half of power's on many separate lights and on
-    /// textured emitting meshes, while on one mesh light of constant radiance (where power
-    /// already picks triangles by area, in proportion to what they emit) it only adds its
-    /// traversal.
+    /// The bounded lights from which `LightSelection::Auto` takes the tree: the smallest
+    /// many-light scene measured where it won (`tests/scenes/mitsuba/many-spheres.xml`, 400
+    /// sphere lights: 0.48x power's error at equal spp; a street of 10,000: 0.25x its
+    /// equal-error time). With a few lights it lost (BENCHMARKS.md, "Light selection").
+    pub const AUTO_TREE_LIGHTS: usize = 400;
+
+    /// What `LightSelection::Auto` means for these lights (see its doc).
     pub fn auto_light_selection(lights: &[Light]) -> LightSelection {
         let bounded = lights.iter().filter(|l| !l.is_infinite() && l.power() > 0.0).count();
         let varying_mesh = lights.iter().any(|l| {
             matches!(l, Light::Mesh { radiance, .. } if !matches!(radiance, Texture::Constant(_))) && lights::by_triangle(l)
         });
-        if bounded >= 2 || varying_mesh {
+        if bounded >= Self::AUTO_TREE_LIGHTS || varying_mesh {
             LightSelection::Tree
         } else {
             LightSelection::Power
