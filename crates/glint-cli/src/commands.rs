@@ -73,7 +73,7 @@ pub struct RenderArgs {
     /// Path tracer estimator: mis, light or bsdf.
     #[arg(long)]
     pub strategy: Option<Strategy>,
-    /// Light selection for next-event estimation: uniform, area, power or tree (a light BVH: by what each light can send to the shading point).
+    /// Light selection for next-event estimation: power (the default), tree (a light BVH: by what each light can send to the shading point), auto (the tree from 400 lights or on a textured emitting mesh, else power), uniform or area.
     #[arg(long)]
     pub light_selection: Option<LightSelection>,
     /// Image width (overrides the scene's film).

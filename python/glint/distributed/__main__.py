@@ -28,7 +28,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--integrator", choices=INTEGRATORS, help="integrator (default: the scene's)")
     p.add_argument("--max-depth", type=int, help="longest path (path: segments, -1 unbounded; whitted: recursion depth)")
     p.add_argument("--strategy", help="path tracer estimator: mis, light or bsdf")
-    p.add_argument("--light-selection", help="light selection for next-event estimation: uniform, area, power or tree")
+    p.add_argument("--light-selection", help="light selection for next-event estimation: power (default), tree, auto, uniform or area")
     p.add_argument("--sampler", help="sampler: sobol (the default) or independent")
     p.add_argument("--width", type=int, help="image width (overrides the scene's film)")
     p.add_argument("--height", type=int, help="image height (overrides the scene's film)")
