@@ -137,8 +137,15 @@ fn auto_selection_is_the_tree_where_it_has_something_to_choose_by() {
             let at = Transform::translate(vec3(k as f32, 1.0, 0.0));
             match *which {
                 "sphere" => {
-                    b.add_sphere(vec3(k as f32, 1.0, 0.0), 0.1, &Transform::IDENTITY, lamp, lit(Rgb::WHITE, false), false)
-                        .unwrap();
+                    b.add_sphere(
+                        vec3(k as f32, 1.0, 0.0),
+                        0.1,
+                        &Transform::IDENTITY,
+                        lamp,
+                        lit(Rgb::WHITE, false),
+                        false,
+                    )
+                    .unwrap();
                 }
                 "disk" => {
                     b.add_mesh_instance(&disk, &at, false, lamp, lit(Rgb::WHITE, false), false).unwrap();

@@ -240,10 +240,15 @@ const TRIANGLE_READS: [[f32; 2]; 19] = {
 /// region is still chosen now and then. Only the choice of triangle depends on it; the
 /// probabilities are exact whatever it says.
 fn textured_luminance(emitter: &super::MeshEmitter, radiance: &Texture, t: usize) -> f32 {
-    let sum: f32 = TRIANGLE_READS.iter().map(|&e| radiance.eval_at(&emitter.texture_point(t, e)).luminance().max(0.0)).sum();
+    let sum: f32 =
+        TRIANGLE_READS.iter().map(|&e| radiance.eval_at(&emitter.texture_point(t, e)).luminance().max(0.0)).sum();
     let mean = sum / TRIANGLE_READS.len() as f32;
     let floor = 1e-3 * radiance.mean().luminance().max(0.0);
-    if mean.is_finite() { mean.max(floor) } else { floor }
+    if mean.is_finite() {
+        mean.max(floor)
+    } else {
+        floor
+    }
 }
 
 /// The bounds of one light; `None` for infinite lights and lights that emit nothing.

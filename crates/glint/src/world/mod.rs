@@ -192,7 +192,8 @@ impl World {
     pub fn auto_light_selection(lights: &[Light]) -> LightSelection {
         let bounded = lights.iter().filter(|l| !l.is_infinite() && l.power() > 0.0).count();
         let varying_mesh = lights.iter().any(|l| {
-            matches!(l, Light::Mesh { radiance, .. } if !matches!(radiance, Texture::Constant(_))) && lights::by_triangle(l)
+            matches!(l, Light::Mesh { radiance, .. } if !matches!(radiance, Texture::Constant(_)))
+                && lights::by_triangle(l)
         });
         if bounded >= Self::AUTO_TREE_LIGHTS || varying_mesh {
             LightSelection::Tree
