@@ -214,7 +214,7 @@ def render(
     Keyword overrides of the scene's settings, as the command line's flags (the scene is
     not changed for later renders): ``integrator`` (one of ``INTEGRATORS``), ``max_depth``
     (path tracers: segments, -1 unbounded; whitted: recursion depth), ``strategy`` (mis,
-    light, bsdf), ``light_selection`` (uniform, area, power, tree), ``sampler`` (sobol,
+    light, bsdf), ``light_selection`` (power, tree, auto, uniform, area), ``sampler`` (sobol,
     independent), ``width``, ``height``.
     """
     s = make_session(scene, spp=spp, seed=seed, aovs=aovs, threads=threads, denoise=denoise, **overrides)

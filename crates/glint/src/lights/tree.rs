@@ -110,7 +110,7 @@ impl Bounds {
 
 /// A node's bounds in the form [`Importance::at`] reads: what `Bounds` gives, with the parts
 /// that do not depend on the shading point (centre, half diagonal, the cone's sine) worked
-/// out once at build time by the same operations as before, so the values are the same bits.
+/// out once at build time rather than at every visit (the same operations, the same bits).
 #[derive(Clone, Copy, Debug)]
 struct Importance {
     center: Vec3,
