@@ -706,6 +706,33 @@ impl SceneDesc {
     pub fn material_index(&self, name: &str) -> Option<usize> {
         self.materials.iter().position(|m| m.name == name)
     }
+
+    /// Adds what `part` places in the world (materials, meshes, shapes, lights, media), its
+    /// references re-indexed to follow this description's own; its camera, film, integrator
+    /// and sampler are dropped. How a scene composes a file of another format (a glTF file
+    /// placed from JSON) as one group of shapes.
+    pub fn append_parts(&mut self, part: SceneDesc) {
+        let (materials, meshes, media) = (self.materials.len(), self.meshes.len(), self.media.len());
+        self.materials.extend(part.materials);
+        self.meshes.extend(part.meshes);
+        self.media.extend(part.media);
+        for mut s in part.shapes {
+            match &mut s.material {
+                MaterialRef::Index(i) => *i += materials,
+                MaterialRef::DefaultDiffuse | MaterialRef::Black => {}
+            }
+            if let Geometry::Instance { mesh } = &mut s.geometry {
+                *mesh += meshes;
+            }
+            for m in [&mut s.media.interior, &mut s.media.exterior].into_iter().flatten() {
+                *m += media;
+            }
+            self.shapes.push(s);
+        }
+        self.lights.extend(part.lights);
+        self.warnings.extend(part.warnings);
+        self.summary.extend(part.summary);
+    }
 }
 
 impl MaterialModel {

@@ -787,6 +787,14 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
     }
 
     for (i, s) in file.shapes.iter().enumerate() {
+        if s.kind == "gltf" {
+            let (gltf, part) = gltf_group(&ctx, i, s)?;
+            desc.append_parts(part);
+            if !desc.includes.contains(&gltf) {
+                desc.includes.push(gltf);
+            }
+            continue;
+        }
         let shape = shape_of(&ctx, &desc, i, s, &medium_ref)?;
         desc.shapes.push(shape);
     }
@@ -1018,7 +1026,7 @@ fn shape_of(ctx: &Ctx, desc: &SceneDesc, i: usize, s: &JsonShape, medium_ref: &M
             return Err(ctx.err(
                 &format!("{at}/type"),
                 format!(
-                "shape {i}: unknown shape type '{other}' (obj, ply, instance, sphere, rectangle, cube, disk, cylinder)"
+                "shape {i}: unknown shape type '{other}' (obj, ply, gltf, instance, sphere, rectangle, cube, disk, cylinder)"
             ),
             ))
         }
@@ -1037,6 +1045,37 @@ fn shape_of(ctx: &Ctx, desc: &SceneDesc, i: usize, s: &JsonShape, medium_ref: &M
             exterior: medium_ref(&s.exterior, &format!("{at}/exterior"))?,
         },
     })
+}
+
+/// A glTF file placed as a group of shapes: its default scene's meshes, materials and
+/// lights, moved by the shape's `transform` (the only other key it takes).
+fn gltf_group(ctx: &Ctx, i: usize, s: &JsonShape) -> Result<(PathBuf, SceneDesc), Error> {
+    let at = format!("shapes/{i}");
+    let given = [
+        ("mesh", s.mesh.is_some()),
+        ("center", s.center.is_some()),
+        ("radius", s.radius.is_some()),
+        ("material", s.material.is_some()),
+        ("emission", s.emission.is_some()),
+        ("two_sided_emission", s.two_sided_emission),
+        ("flip_normals", s.flip_normals),
+        ("face_normals", s.face_normals),
+        ("interior", s.interior.is_some()),
+        ("exterior", s.exterior.is_some()),
+        ("p0", s.p0.is_some()),
+        ("p1", s.p1.is_some()),
+    ];
+    if let Some((key, _)) = given.iter().find(|(_, set)| *set) {
+        return Err(ctx.err(
+            &format!("{at}/{key}"),
+            format!("shape {i} (gltf): '{key}' does not apply (a glTF file brings its own materials; it takes 'file' and 'transform')"),
+        ));
+    }
+    let file = s.file.as_ref().ok_or_else(|| ctx.err(&at, format!("shape {i} (gltf): needs 'file'")))?;
+    let to_world = transform_of(&s.transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?;
+    let path = ctx.resolve(file);
+    let part = crate::formats::gltf::read_placed(&path, &to_world)?;
+    Ok((path, part))
 }
 
 fn light_of(ctx: &Ctx, at: &str, l: &JsonLight) -> Result<LightKind, Error> {

@@ -10,7 +10,7 @@ mod lights;
 mod material;
 mod scene;
 
-use crate::describe::{CameraDesc, FilmDesc, PixelFilter, SceneDesc};
+use crate::describe::{CameraDesc, FilmDesc, Matrix4, PixelFilter, SceneDesc, IDENTITY};
 use crate::error::{Error, SourceLoc};
 use crate::io::gltf::GltfFile;
 use serde_json::Value;
@@ -45,8 +45,26 @@ pub fn read(path: &Path, camera: Option<&str>) -> Result<SceneDesc, Error> {
     describe(&file, path, camera).map_err(|e| Error::at(&loc, e))
 }
 
+/// Reads a glTF file as a group of shapes placed by `to_world` in a scene of another file
+/// (JSON): its nodes and lights all move with it; its cameras are not used.
+pub fn read_placed(path: &Path, to_world: &Matrix4) -> Result<SceneDesc, Error> {
+    let loc = SourceLoc::file(path);
+    let file = crate::io::gltf::open_cached(path).map_err(|e| Error::at(&loc, e))?;
+    describe_placed(&file, path, None, to_world).map_err(|e| Error::at(&loc, e))
+}
+
 /// The description of an open glTF file (the fuzz target calls this on bytes).
 pub fn describe(file: &GltfFile, path: &Path, camera: Option<&str>) -> Result<SceneDesc, String> {
+    describe_placed(file, path, Some(camera), &IDENTITY)
+}
+
+/// `camera`: `None` for a placed group (no camera chosen), else the whole scene's choice.
+fn describe_placed(
+    file: &GltfFile,
+    path: &Path,
+    camera: Option<Option<&str>>,
+    to_world: &Matrix4,
+) -> Result<SceneDesc, String> {
     let loc = SourceLoc::file(path);
     let mut warnings = check_extensions(file)?;
     let cam = CameraDesc { loc: loc.clone(), ..CameraDesc::default() };
@@ -55,8 +73,10 @@ pub fn describe(file: &GltfFile, path: &Path, camera: Option<&str>) -> Result<Sc
     let mut d = SceneDesc::empty(cam, film);
     d.source = Some(path.to_path_buf());
     let materials = material::materials(file, path, &mut d)?;
-    let walk = scene::place(file, path, &mut d, &materials, &mut warnings)?;
-    camera::choose(file, &walk, camera, &mut d, &mut warnings)?;
+    let walk = scene::place(file, path, to_world, &mut d, &materials, &mut warnings)?;
+    if let Some(camera) = camera {
+        camera::choose(file, &walk, camera, &mut d, &mut warnings)?;
+    }
     lights::punctual(file, &walk, &mut d)?;
     d.summary = walk.summary(file, &d, &warnings);
     d.warnings.extend(warnings);

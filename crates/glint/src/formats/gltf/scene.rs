@@ -205,10 +205,12 @@ fn transform_bounds(points: &[crate::math::Vec3], m: &Matrix4) -> Aabb {
     out
 }
 
-/// Walks the default scene, adding a shape for every placed primitive.
+/// Walks the default scene from `root` (the identity for a whole scene), adding a shape
+/// for every placed primitive.
 pub fn place(
     file: &GltfFile,
     path: &Path,
+    root: &Matrix4,
     d: &mut SceneDesc,
     materials: &Materials,
     warnings: &mut Vec<String>,
@@ -230,7 +232,7 @@ pub fn place(
             .as_u64()
             .filter(|&n| (n as usize) < nodes.len())
             .ok_or_else(|| format!("{p}: {r} is not a node index ({} nodes)", nodes.len()))?;
-        stack.push((n as usize, IDENTITY, p));
+        stack.push((n as usize, *root, p));
     }
     let mut seen = vec![false; nodes.len()];
     let mut first_flat = Vec::with_capacity(file.array("meshes").len());
