@@ -9,10 +9,12 @@ import os
 import pathlib
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import threading
 import time
+import zlib
 
 import numpy as np
 import pytest
@@ -224,6 +226,53 @@ def test_a_pack_needs_none_of_the_drivers_files(tmp_path):
     (tmp_path / "copy").mkdir()
     again = _pack.unpack(p, str(tmp_path / "copy"))
     same_bits(glint.render(again, spp=2).image, before)
+
+
+def png_rgb(width, height, rgb):
+    """A PNG of one colour, written without an imaging library."""
+    raw = b"".join(b"\0" + bytes(rgb) * width for _ in range(height))
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+
+
+def test_a_pack_ships_a_gltf_files_buffers_and_images(tmp_path):
+    src = tmp_path / "src"
+    (src / "buffers").mkdir(parents=True)
+    (src / "textures").mkdir()
+    positions = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)
+    uvs = struct.pack("<8f", 0, 1, 1, 1, 1, 0, 0, 0)
+    (src / "buffers" / "quad.bin").write_bytes(positions + uvs)
+    (src / "textures" / "paint.png").write_bytes(png_rgb(2, 2, (200, 90, 30)))
+    doc = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 3]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1}}],
+        "materials": [{"emissiveTexture": {"index": 0}, "emissiveFactor": [1, 1, 1]}],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "textures/paint.png"}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "mode": 6, "material": 0}]}],
+        "buffers": [{"byteLength": 80, "uri": "buffers/quad.bin"}],
+        "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+        ],
+    }
+    (src / "quad.gltf").write_text(json.dumps(doc))
+    scene = glint.load_file(src / "quad.gltf")
+    before = glint.render(scene, spp=2, width=16, height=16).image
+    assert before.max() > 0
+    p = _pack.pack(scene)
+    assert sorted(os.path.basename(k) for k in p.files) == ["paint.png", "quad.bin", "quad.gltf"]
+    shutil.rmtree(src)
+    (tmp_path / "copy").mkdir()
+    again = _pack.unpack(p, str(tmp_path / "copy"))
+    same_bits(glint.render(again, spp=2, width=16, height=16).image, before)
 
 
 def test_plan_skips_work_the_film_holds_and_refuses_misaligned_blocks():

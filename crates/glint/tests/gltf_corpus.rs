@@ -61,7 +61,11 @@ fn check(file: &Path, triangles: u64, min: [f64; 3], max: [f64; 3]) -> Result<()
     d.film.width = 24;
     d.film.height = 24;
     d.sampler.spp = 2;
-    d.lights.push(LightDesc { light: LightKind::Constant { radiance: Rgb::splat(1.0) }, loc: SourceLoc::default() });
+    d.lights.push(LightDesc {
+        light: LightKind::Constant { radiance: Rgb::splat(1.0) },
+        name: None,
+        loc: SourceLoc::default(),
+    });
     let world = s.world().map_err(|e| e.to_string())?;
     if world.triangle_count() as u64 != triangles {
         return Err(format!("{} triangles, the index says {triangles}", world.triangle_count()));

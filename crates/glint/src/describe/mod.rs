@@ -489,6 +489,10 @@ pub struct MeshData {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LightDesc {
     pub light: LightKind,
+    /// The file's name for the light (a glTF light's `name`), by which `traverse` names
+    /// its parameters; `None` where the format names none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     pub loc: SourceLoc,
 }
 
@@ -900,6 +904,7 @@ mod tests {
         }
         d.lights.push(LightDesc {
             light: LightKind::EnvMap { file: "sky.exr".into(), scale: 1.0, to_world: IDENTITY },
+            name: None,
             loc: SourceLoc::default(),
         });
         d.shapes.push(ShapeDesc {
@@ -920,6 +925,7 @@ mod tests {
                 beam_degrees: 15.0,
                 texture: bitmap("slide.png"),
             },
+            name: None,
             loc: SourceLoc::default(),
         });
         d.lights.push(LightDesc {
@@ -930,6 +936,7 @@ mod tests {
                 fov_degrees: 30.0,
                 fov_axis: FovAxis::X,
             },
+            name: None,
             loc: SourceLoc::default(),
         });
         d

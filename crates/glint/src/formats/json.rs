@@ -801,7 +801,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
 
     for (i, l) in file.lights.iter().enumerate() {
         let at = format!("lights/{i}");
-        desc.lights.push(LightDesc { light: light_of(&ctx, &at, l)?, loc: ctx.loc(&at) });
+        desc.lights.push(LightDesc { light: light_of(&ctx, &at, l)?, name: None, loc: ctx.loc(&at) });
     }
     Ok(desc)
 }

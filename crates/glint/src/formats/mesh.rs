@@ -36,9 +36,10 @@ pub fn describe(path: &Path) -> Result<SceneDesc, Error> {
         loc: loc.clone(),
         media: Default::default(),
     });
-    d.lights.push(LightDesc { light: LightKind::Constant { radiance: Rgb::splat(0.4) }, loc: loc.clone() });
+    d.lights.push(LightDesc { light: LightKind::Constant { radiance: Rgb::splat(0.4) }, name: None, loc: loc.clone() });
     d.lights.push(LightDesc {
         light: LightKind::Directional { direction: Vec3 { x: 1.0, y: -2.0, z: -1.5 }, irradiance: Rgb::splat(2.5) },
+        name: None,
         loc,
     });
     Ok(d)

@@ -192,10 +192,10 @@ impl GltfMaterial {
         let mut b = self.factors;
         if let Some(t) = &self.base_color_texture {
             let c = t.rgba_at(p);
-            b.base_color = b.base_color * rgb(c[0], c[1], c[2]);
+            b.base_color *= rgb(c[0], c[1], c[2]);
         }
         if let Some(c) = vertex_value(p, COLOR_ATTRIBUTE) {
-            b.base_color = b.base_color * c;
+            b.base_color *= c;
         }
         if let Some(t) = &self.metallic_roughness_texture {
             let c = t.rgba_at(p);

@@ -8,7 +8,8 @@
 //!
 //! Names: `materials.NAME.FIELD` (`reflectance`, `kd`, `diffuse` when the texture is a
 //! constant; `ks`, `exponent`, `eta`, `k`, `specular`, `reflect`, `transmit`, `alpha`),
-//! `lights.I.FIELD` (`intensity`, `irradiance`, `radiance`, `scale`), `shapes.I.emission`,
+//! `lights.I.FIELD` or `lights.NAME.FIELD` for a light its file names (glTF's) (`intensity`,
+//! `irradiance`, `radiance`, `scale`), `shapes.I.emission`,
 //! `shapes.I.to_world`, `camera.fov`, `camera.to_world`.
 
 use super::Session;
@@ -197,9 +198,18 @@ fn slots(desc: &mut SceneDesc) -> Vec<(String, Slot<'_>, Effect)> {
         }
         out.push((format!("shapes.{i}.to_world"), Slot::Matrix(&mut s.to_world), Effect::Transform(i)));
     }
+    // A light is named by its file's name where it has one no other light shares (a glTF
+    // light's), else by its index.
+    let names: Vec<Option<String>> = desc.lights.iter().map(|l| l.name.clone()).collect();
     for (i, l) in desc.lights.iter_mut().enumerate() {
+        let label = match &l.name {
+            Some(n) if names.iter().filter(|m| m.as_ref() == Some(n)).count() == 1 && n.parse::<usize>().is_err() => {
+                n.clone()
+            }
+            _ => i.to_string(),
+        };
         for (field, slot) in light_slots(&mut l.light) {
-            out.push((format!("lights.{i}.{field}"), slot, Effect::Appearance));
+            out.push((format!("lights.{label}.{field}"), slot, Effect::Appearance));
         }
     }
     out.push(("camera.fov".to_string(), Slot::Float(&mut desc.camera.fov_degrees), Effect::Appearance));

@@ -73,7 +73,10 @@ pub fn punctual(file: &GltfFile, walk: &Walk, d: &mut SceneDesc) -> Result<(), S
             }
             other => return Err(format!("{lp}.type: {other:?} is not point, spot or directional")),
         };
-        d.lights.push(LightDesc { light, loc: loc.clone() });
+        // The light's own name, else its node's: what `traverse` calls it.
+        let named = |v: &Value| v.get("name").and_then(Value::as_str).filter(|s| !s.is_empty()).map(str::to_string);
+        let name = named(l).or_else(|| file.array("nodes").get(*node).and_then(named));
+        d.lights.push(LightDesc { light, name, loc: loc.clone() });
     }
     Ok(())
 }

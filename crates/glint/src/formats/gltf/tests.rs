@@ -253,7 +253,7 @@ fn lights_convert_photometric_units_at_683_lumens_per_watt() {
         json!({"extensions": lights, "nodes": [
             {"mesh": 0},
             {"translation": [0, 2, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
-            {"rotation": [-0.7071067811865476, 0, 0, 0.7071067811865476], "extensions": {"KHR_lights_punctual": {"light": 1}}},
+            {"rotation": [-std::f64::consts::FRAC_1_SQRT_2, 0, 0, std::f64::consts::FRAC_1_SQRT_2], "extensions": {"KHR_lights_punctual": {"light": 1}}},
         ], "scenes": [{"nodes": [0, 1, 2]}]}),
     );
     let s = scene(&d).unwrap();

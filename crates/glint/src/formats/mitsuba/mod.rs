@@ -570,7 +570,7 @@ impl<'a> Reader<'a> {
             other => return Err(el.err(format!("emitter plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
-        self.lights.push(LightDesc { light, loc: el.loc() });
+        self.lights.push(LightDesc { light, name: None, loc: el.loc() });
         Ok(())
     }
 
