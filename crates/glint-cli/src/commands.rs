@@ -22,7 +22,8 @@ pub struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to an image (.png, .exr or .pfm). Scenes: glint's JSON (.json),
-    /// Mitsuba 3 XML (.xml), or a bare mesh (.obj, .ply) in a preview setting.
+    /// Mitsuba 3 XML (.xml), glTF 2.0 (.gltf, .glb), or a bare mesh (.obj, .ply) in a
+    /// preview setting.
     Render(RenderArgs),
     /// Continue a checkpointed render (bit-identical to an uninterrupted one).
     Resume(ResumeArgs),
