@@ -16,7 +16,7 @@ fuzz_target!(|data: &[u8]| {
     desc.film.height = 4;
     desc.sampler.spp = 1;
     let Ok(world) = glint::assemble::build(&desc, &Default::default()) else { return };
-    let integrator = glint::integrators::Integrator::from(&desc.integrator);
+    let integrator = glint::integrators::Integrator::from(desc.integrator.clone());
     let settings = glint::render::RenderSettings { spp: 1, ..Default::default() };
     let out = glint::render::render(&world, &integrator, &settings, &glint::render::Silent);
     assert!(out.image.pixels.iter().all(|p| p.is_finite()), "a non-finite pixel");
