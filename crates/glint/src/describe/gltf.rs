@@ -121,6 +121,14 @@ impl GltfMaterialDesc {
         }
     }
 
+    /// Whether a ray meeting the surface's back face passes through it (the specification's
+    /// back-face culling for `doubleSided: false`): every single-sided surface but the
+    /// boundary of a volume (`KHR_materials_volume` with thickness > 0), which stays
+    /// two-sided as that extension says.
+    pub fn culls_back_faces(&self) -> bool {
+        !self.double_sided && self.thin_walled
+    }
+
     /// The textures, in a fixed order (base colour, metal/rough, normal).
     pub fn textures(&self) -> Vec<&super::TextureDesc> {
         [&self.base_color_texture, &self.metallic_roughness_texture, &self.normal_texture]

@@ -783,6 +783,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             face_normals: m.face_normals,
             loc: ctx.loc(&format!("meshes/{name}")),
             shape_index: 0,
+            reverse_winding: false,
         });
     }
 

@@ -17,29 +17,37 @@ pub(crate) fn texture_point<'a>(scene: &'a World, si: &SurfaceInteraction) -> Te
     scene.texture_point(si)
 }
 
-/// The probability that light meeting the surface at `si` scatters there (1 unless masked).
-pub(crate) fn opacity(scene: &World, si: &SurfaceInteraction) -> f32 {
+/// The probability that light travelling along `dir` and meeting the surface at `si`
+/// scatters there: 1 unless masked, and 0 at the back face of a material whose back faces
+/// are culled (single-sided glTF): the face whose geometric normal `si.ng` (after the
+/// instance's transform, counter-clockwise winding in front) points along `dir`.
+pub(crate) fn opacity(scene: &World, si: &SurfaceInteraction, dir: Vec3) -> f32 {
     let mat = &scene.materials[si.material as usize];
+    if mat.cull_back_faces && si.ng.dot(dir) > 0.0 {
+        return 0.0;
+    }
     if !mat.is_masked() {
         return 1.0;
     }
     mat.opacity(&texture_point(scene, si))
 }
 
-/// Whether a ray that met the surface at `si` after `passes` earlier passes goes on through
-/// it unscattered: a masked surface lets it pass with probability 1 - opacity (one random
-/// number per masked surface met), up to [`MAX_MASK_PASSES`] times along one path segment.
+/// Whether a ray along `dir` that met the surface at `si` after `passes` earlier passes goes
+/// on through it unscattered: a masked surface (or a culled back face, of opacity 0) lets it
+/// pass with probability 1 - opacity (one random number per masked surface met), up to
+/// [`MAX_MASK_PASSES`] times along one path segment.
 #[inline]
-pub(crate) fn passes_mask(scene: &World, si: &SurfaceInteraction, passes: u32, rng: &mut Sampler) -> bool {
+pub(crate) fn passes_mask(scene: &World, si: &SurfaceInteraction, dir: Vec3, passes: u32, rng: &mut Sampler) -> bool {
     if !scene.has_masks || passes >= MAX_MASK_PASSES {
         return false;
     }
-    let o = opacity(scene, si);
+    let o = opacity(scene, si, dir);
     o < 1.0 && rng.next_f32() >= o
 }
 
 /// The fraction of light that gets along a shadow ray: 1 when nothing blocks it, 0 when an
-/// opaque surface does, the product of (1 − opacity) over the masked surfaces it crosses
+/// opaque surface does, the product of (1 − opacity) over the masked surfaces (and culled
+/// back faces) it crosses
 /// otherwise (the expected value of passing each one, as Mitsuba's volumetric path tracer
 /// counts null surfaces; its `path` integrator stops shadow rays at every surface).
 pub(crate) fn transmittance(scene: &World, ray: &Ray, c: &mut Counters) -> f32 {
@@ -59,7 +67,7 @@ pub(crate) fn transmittance_if_blocked(scene: &World, ray: &Ray, blocked: bool, 
     for _ in 0..MAX_MASK_PASSES {
         let Some(hit) = scene.intersect(&r) else { return t };
         let si = scene.interaction(&r, &hit);
-        t *= 1.0 - opacity(scene, &si);
+        t *= 1.0 - opacity(scene, &si, r.dir);
         if !(t > 0.0) {
             return 0.0;
         }
