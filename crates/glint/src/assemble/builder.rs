@@ -95,7 +95,7 @@ pub fn read_mesh_file(
 }
 
 /// Primitive `flat` of a glTF file (see [`crate::io::gltf::GltfFile::primitive_at`]), with
-/// its second texture coordinate set and vertex colours as mesh attributes; `reverse` gives
+/// its second texture coordinate set, vertex colours and tangents as mesh attributes; `reverse` gives
 /// each triangle the opposite winding (for a placement by a mirroring transform).
 fn gltf_primitive(
     path: &Path,
@@ -105,7 +105,9 @@ fn gltf_primitive(
     split: BvhSplit,
 ) -> Result<TriangleMesh, String> {
     use crate::geometry::{AttributeScope, MeshAttribute};
-    use crate::materials::{ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, UV1_ATTRIBUTE};
+    use crate::materials::{
+        ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, TANGENT_ATTRIBUTE, TANGENT_SIGN_ATTRIBUTE, UV1_ATTRIBUTE,
+    };
     let at = |e: String| format!("{}: {e}", path.display());
     let f = crate::io::gltf::open_cached(path).map_err(at)?;
     let (mesh, prim) = f.primitive_at(flat as usize).ok_or_else(|| at(format!("no primitive {flat}")))?;
@@ -128,6 +130,10 @@ fn gltf_primitive(
     if let Some(c) = &p.colors {
         attributes.push(attribute(COLOR_ATTRIBUTE, 3, c.iter().flat_map(|c| [c[0], c[1], c[2]]).collect()));
         attributes.push(attribute(ALPHA_ATTRIBUTE, 1, c.iter().map(|c| c[3]).collect()));
+    }
+    if let Some(t) = &p.tangents {
+        attributes.push(attribute(TANGENT_ATTRIBUTE, 3, t.iter().flat_map(|t| [t[0], t[1], t[2]]).collect()));
+        attributes.push(attribute(TANGENT_SIGN_ATTRIBUTE, 1, t.iter().map(|t| t[3]).collect()));
     }
     let normals = if face_normals { None } else { p.normals };
     let ctx = format!("meshes[{mesh}].primitives[{prim}]");

@@ -13,6 +13,9 @@ use std::sync::Arc;
 pub const UV1_ATTRIBUTE: &str = "vertex_gltf_uv1";
 pub const COLOR_ATTRIBUTE: &str = "vertex_gltf_color";
 pub const ALPHA_ATTRIBUTE: &str = "vertex_gltf_alpha";
+/// `TANGENT`'s xyz (object space) and its w, the bitangent's sign.
+pub const TANGENT_ATTRIBUTE: &str = "vertex_gltf_tangent";
+pub const TANGENT_SIGN_ATTRIBUTE: &str = "vertex_gltf_tangent_sign";
 
 /// A glTF texture ready to sample.
 #[derive(Clone, Debug)]
