@@ -3,8 +3,8 @@
 //! shapes that use it.
 
 use crate::describe::{
-    Emission, GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, GltfWrap, MaterialDesc, MaterialModel, SceneDesc,
-    TextureDesc,
+    Emission, GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, GltfWrap, MaterialDesc, MaterialModel, MediumDesc,
+    PhaseDesc, SceneDesc, TextureDesc, VolumeDesc,
 };
 use crate::error::SourceLoc;
 use crate::io::gltf::{GltfFile, Node};
@@ -13,10 +13,13 @@ use serde_json::Value;
 use std::cell::Cell;
 use std::path::Path;
 
-/// The description's material for each glTF material, and the emission of each.
+/// The description's material for each glTF material, the emission of each, and the
+/// medium inside each that bounds an absorbing volume.
 pub struct Materials {
     pub index: Vec<usize>,
     pub emission: Vec<Option<Emission>>,
+    /// Index into the description's media: `KHR_materials_volume`'s attenuation inside.
+    pub interior: Vec<Option<usize>>,
     default: Cell<Option<usize>>,
 }
 
@@ -247,7 +250,7 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
 
 /// Every material of the file, added to the description in the file's order.
 pub fn materials(file: &GltfFile, path: &Path, d: &mut SceneDesc) -> Result<Materials, String> {
-    let mut out = Materials { index: Vec::new(), emission: Vec::new(), default: Cell::new(None) };
+    let mut out = Materials { index: Vec::new(), emission: Vec::new(), interior: Vec::new(), default: Cell::new(None) };
     let loc = SourceLoc::file(path);
     for mi in 0..file.array("materials").len() {
         let (g, emissive_texture, emissive) = material(file, path, mi)?;
@@ -259,10 +262,39 @@ pub fn materials(file: &GltfFile, path: &Path, d: &mut SceneDesc) -> Result<Mate
         let emission = emission(&g, emissive_texture, emissive);
         out.index.push(d.materials.len());
         out.emission.push(emission);
+        out.interior.push(volume_medium(&g, &name, &loc).map(|m| {
+            d.media.push(m);
+            d.media.len() - 1
+        }));
         let two_sided = g.double_sided;
         d.materials.push(MaterialDesc { name, model: MaterialModel::Gltf(g), two_sided, loc: loc.clone() });
     }
     Ok(out)
+}
+
+/// The absorbing medium inside a `KHR_materials_volume` boundary (thickness > 0) that lets
+/// light in (transmission > 0) and attenuates (a finite `attenuationDistance`, an
+/// `attenuationColor` below 1 in some channel): Beer-Lambert absorption, sigma_a =
+/// -ln(attenuationColor) / attenuationDistance per channel (a channel of colour 0 absorbs at
+/// glint's largest extinction), nothing scattered.
+fn volume_medium(g: &GltfMaterialDesc, name: &str, loc: &SourceLoc) -> Option<MediumDesc> {
+    let absorbs = g.attenuation_color.to_array().iter().any(|&c| c < 1.0);
+    if g.thin_walled || !(g.transmission > 0.0) || !(g.attenuation_distance < f32::MAX) || !absorbs {
+        return None;
+    }
+    let d = g.attenuation_distance as f64;
+    let sigma = |c: f32| ((-(c as f64).ln() / d).min(crate::assemble::MAX_EXTINCTION as f64) as f32).max(0.0);
+    let c = g.attenuation_color;
+    Some(MediumDesc {
+        name: format!("{name} (KHR_materials_volume)"),
+        sigma_t: crate::math::rgb(sigma(c.r), sigma(c.g), sigma(c.b)),
+        albedo: VolumeDesc::Constant(Rgb::BLACK),
+        scale: 1.0,
+        phase: PhaseDesc::Isotropic,
+        sample_emitters: false,
+        density: None,
+        loc: loc.clone(),
+    })
 }
 
 /// What a material's surfaces emit: the emissive colour (times its texture), or for an

@@ -291,9 +291,11 @@ pub fn place(
                 if info.triangles == 0 {
                     continue;
                 }
-                let (material, emission) = match info.material {
-                    Some(m) => (MaterialRef::Index(materials.index[m]), materials.emission[m].clone()),
-                    None => (MaterialRef::Index(materials.default_material(d)), None),
+                let (material, emission, interior) = match info.material {
+                    Some(m) => {
+                        (MaterialRef::Index(materials.index[m]), materials.emission[m].clone(), materials.interior[m])
+                    }
+                    None => (MaterialRef::Index(materials.default_material(d)), None, None),
                 };
                 for inst in &instances {
                     if d.shapes.len() >= MAX_INSTANCES {
@@ -313,7 +315,10 @@ pub fn place(
                         });
                         d.meshes.len() - 1
                     });
-                    d.shapes.push(shape(mesh_index, to_world, material, emission.clone(), &loc));
+                    let mut s = shape(mesh_index, to_world, material, emission.clone(), &loc);
+                    // A volume's absorbing medium inside; outside, none (vacuum).
+                    s.media.interior = interior;
+                    d.shapes.push(s);
                     walk.primitives += 1;
                     walk.triangles += info.triangles as u64;
                     let wb = transform_bounds(&info.points, &to_world);

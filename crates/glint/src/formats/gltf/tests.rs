@@ -167,6 +167,68 @@ fn a_shared_mesh_is_one_mesh_placed_twice() {
 }
 
 #[test]
+fn a_mirroring_placement_uses_the_primitive_with_its_winding_reversed() {
+    // Mirrored in x (negative determinant): glTF keeps the front where the mirrored normal
+    // points, so that placement reads the primitive with its triangles reversed; the
+    // unmirrored one and a rotation (positive determinant) share the primitive as it is.
+    let d = triangle_doc(
+        json!({}),
+        json!({"nodes": [{"mesh": 0}, {"mesh": 0, "scale": [-1, 1, 1]}, {"mesh": 0, "rotation": [0, 0, 1, 0]}],
+               "scenes": [{"nodes": [0, 1, 2]}]}),
+    );
+    let s = scene(&d).unwrap();
+    assert_eq!(s.meshes.len(), 2);
+    let mesh = |i: usize| match s.shapes[i].geometry {
+        Geometry::Instance { mesh } => &s.meshes[mesh],
+        _ => panic!("shape {i} is not an instance"),
+    };
+    assert!(!mesh(0).reverse_winding && mesh(1).reverse_winding && !mesh(2).reverse_winding);
+    assert_eq!(mesh(0).shape_index, mesh(1).shape_index);
+}
+
+/// A triangle with one material whose `extensions` are `ext`.
+fn material_doc(ext: Value) -> Value {
+    triangle_doc(
+        json!({}),
+        json!({"materials": [{"name": "glass", "extensions": ext}],
+               "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+               "nodes": [{"mesh": 0}]}),
+    )
+}
+
+#[test]
+fn an_attenuating_volume_is_an_absorbing_medium_inside_its_surface() {
+    use crate::describe::{IntegratorDesc, VolumeDesc};
+    let volume = |v: Value| {
+        material_doc(json!({"KHR_materials_transmission": {"transmissionFactor": 0.5}, "KHR_materials_volume": v}))
+    };
+    let s =
+        scene(&volume(json!({"thicknessFactor": 1, "attenuationColor": [0.5, 1.0, 0.0], "attenuationDistance": 4})))
+            .unwrap();
+    assert_eq!(s.media.len(), 1);
+    let m = &s.media[0];
+    // sigma_a = -ln(colour) / distance; colour 0 absorbs at the largest extinction allowed.
+    assert!((m.sigma_t.r - std::f32::consts::LN_2 / 4.0).abs() < 1e-7, "{:?}", m.sigma_t);
+    assert_eq!(m.sigma_t.g, 0.0);
+    assert_eq!(m.sigma_t.b, crate::assemble::MAX_EXTINCTION);
+    assert_eq!(m.albedo, VolumeDesc::Constant(crate::math::Rgb::BLACK));
+    assert_eq!((s.shapes[0].media.interior, s.shapes[0].media.exterior), (Some(0), None));
+    assert!(matches!(s.integrator, IntegratorDesc::Volpath(_)), "{:?}", s.integrator);
+    // No medium (and the path tracer) for a thin wall, no attenuation, or no transmission.
+    for d in [
+        volume(json!({"thicknessFactor": 0, "attenuationColor": [0.5, 0.5, 0.5], "attenuationDistance": 4})),
+        volume(json!({"thicknessFactor": 1, "attenuationColor": [0.5, 0.5, 0.5]})),
+        volume(json!({"thicknessFactor": 1, "attenuationColor": [1, 1, 1], "attenuationDistance": 4})),
+        material_doc(json!({"KHR_materials_volume":
+            {"thicknessFactor": 1, "attenuationColor": [0.5, 0.5, 0.5], "attenuationDistance": 4}})),
+    ] {
+        let s = scene(&d).unwrap();
+        assert!(s.media.is_empty() && s.shapes[0].media.interior.is_none());
+        assert!(matches!(s.integrator, IntegratorDesc::Path(_)));
+    }
+}
+
+#[test]
 fn errors_name_the_json_path() {
     // POSITION's accessor claims 4 vertices; the buffer holds 3.
     let mut d = triangle_doc(json!({"mesh": 0}), json!({}));
