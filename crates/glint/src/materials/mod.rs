@@ -10,8 +10,8 @@ mod surface;
 mod texture;
 pub use blend::{BlendMaterial, BlendMaterialPart};
 pub use gltf::{
-    GltfAlpha, GltfMaterial, GltfTexture, ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, TANGENT_ATTRIBUTE, TANGENT_SIGN_ATTRIBUTE,
-    UV1_ATTRIBUTE,
+    GltfAlpha, GltfExtensionTextures, GltfMaterial, GltfTexture, ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, TANGENT_ATTRIBUTE,
+    TANGENT_SIGN_ATTRIBUTE, UV1_ATTRIBUTE,
 };
 pub use principled::PrincipledMaterial;
 pub use roughness::RoughnessMap;

@@ -189,8 +189,14 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
             return Err(format!("{p}.ior: {ior} is less than 1"));
         }
     }
+    // An extension's texture `key` of `n` (at `p`), if it has one.
+    let ext_tex = |n: &Node, p: &str, key: &str, srgb: bool| -> Result<Option<TextureDesc>, String> {
+        n.get(key).map(|t| tex(t, &format!("{p}.{key}"), srgb)).transpose()
+    };
     if let Some((v, p)) = e("KHR_materials_transmission") {
-        g.transmission = unit(&Node::new(v, &p), "transmissionFactor", 0.0)?;
+        let n = Node::new(v, &p);
+        g.transmission = unit(&n, "transmissionFactor", 0.0)?;
+        g.transmission_texture = ext_tex(&n, &p, "transmissionTexture", false)?;
     }
     if let Some((v, p)) = e("KHR_materials_volume") {
         let n = Node::new(v, &p);
@@ -203,6 +209,7 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
             return Err(format!("{p}.attenuationDistance: {dist} must be positive"));
         }
         g.attenuation_distance = dist.min(f32::MAX as f64) as f32;
+        g.thickness_texture = ext_tex(&n, &p, "thicknessTexture", false)?;
     }
     if let Some((v, p)) = e("KHR_materials_specular") {
         let n = Node::new(v, &p);
@@ -212,17 +219,23 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
             return Err(format!("{p}.specularColorFactor: components must not be negative"));
         }
         g.specular_color = rgb(c[0] as f32, c[1] as f32, c[2] as f32);
+        g.specular_texture = ext_tex(&n, &p, "specularTexture", false)?;
+        g.specular_color_texture = ext_tex(&n, &p, "specularColorTexture", true)?;
     }
     if let Some((v, p)) = e("KHR_materials_clearcoat") {
         let n = Node::new(v, &p);
         g.clearcoat = unit(&n, "clearcoatFactor", 0.0)?;
         g.clearcoat_roughness = unit(&n, "clearcoatRoughnessFactor", 0.0)?;
+        g.clearcoat_texture = ext_tex(&n, &p, "clearcoatTexture", false)?;
+        g.clearcoat_roughness_texture = ext_tex(&n, &p, "clearcoatRoughnessTexture", false)?;
     }
     if let Some((v, p)) = e("KHR_materials_sheen") {
         let n = Node::new(v, &p);
         let c = color(&n, "sheenColorFactor", [0.0; 4], 3)?;
         g.sheen_color = rgb(c[0], c[1], c[2]);
         g.sheen_roughness = unit(&n, "sheenRoughnessFactor", 0.0)?;
+        g.sheen_color_texture = ext_tex(&n, &p, "sheenColorTexture", true)?;
+        g.sheen_roughness_texture = ext_tex(&n, &p, "sheenRoughnessTexture", false)?;
     }
     g.unlit = e("KHR_materials_unlit").is_some();
     // Emission: factor x strength, textured or not.

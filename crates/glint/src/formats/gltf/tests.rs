@@ -229,6 +229,43 @@ fn an_attenuating_volume_is_an_absorbing_medium_inside_its_surface() {
 }
 
 #[test]
+fn extension_textures_are_read_with_their_colour_spaces_and_errors_name_them() {
+    use crate::describe::{MaterialModel, TextureDesc};
+    let t = |i: usize| json!({"index": i});
+    let with_textures = |ext: Value| {
+        let mut d = material_doc(ext);
+        d["images"] = json!([{"uri": "a.png"}, {"uri": "b.png"}]);
+        d["textures"] = json!([{"source": 0}, {"source": 1}]);
+        d
+    };
+    let s = scene(&with_textures(json!({
+        "KHR_materials_specular": {"specularTexture": t(0), "specularColorTexture": t(1)},
+        "KHR_materials_transmission": {"transmissionTexture": t(0)},
+        "KHR_materials_clearcoat": {"clearcoatTexture": t(1), "clearcoatRoughnessTexture": t(0)},
+        "KHR_materials_sheen": {"sheenColorTexture": t(0), "sheenRoughnessTexture": t(1)},
+        "KHR_materials_volume": {"thicknessTexture": {"index": 1, "texCoord": 1}}
+    })))
+    .unwrap();
+    let MaterialModel::Gltf(g) = &s.materials[0].model else { panic!("not a glTF material") };
+    let read = |t: &Option<TextureDesc>| match t {
+        Some(TextureDesc::Gltf(t)) => (t.image, t.srgb, t.texcoord),
+        other => panic!("{other:?}"),
+    };
+    // (image, sRGB, texture coordinate set): colours are sRGB, the rest linear.
+    assert_eq!(read(&g.specular_texture), (0, false, 0));
+    assert_eq!(read(&g.specular_color_texture), (1, true, 0));
+    assert_eq!(read(&g.transmission_texture), (0, false, 0));
+    assert_eq!(read(&g.clearcoat_texture), (1, false, 0));
+    assert_eq!(read(&g.clearcoat_roughness_texture), (0, false, 0));
+    assert_eq!(read(&g.sheen_color_texture), (0, true, 0));
+    assert_eq!(read(&g.sheen_roughness_texture), (1, false, 0));
+    assert_eq!(read(&g.thickness_texture), (1, false, 1));
+    assert_eq!(g.textures().len(), 8);
+    let e = scene(&with_textures(json!({"KHR_materials_sheen": {"sheenColorTexture": t(7)}}))).unwrap_err();
+    assert!(e.starts_with("materials[0].extensions.KHR_materials_sheen.sheenColorTexture.index: "), "{e}");
+}
+
+#[test]
 fn errors_name_the_json_path() {
     // POSITION's accessor claims 4 vertices; the buffer holds 3.
     let mut d = triangle_doc(json!({"mesh": 0}), json!({}));
