@@ -4,10 +4,12 @@
 //! rendered by the volumetric path tracer (which a glTF scene gets when it has such a
 //! volume). A thin-walled surface (thickness 0) absorbs nothing.
 //!
-//! The scene: a cube of side 2 (a glTF mesh, fully transmissive, ior 1, roughness 0, so its
-//! surface neither reflects nor bends light seen face on) in front of an emitting wall of
-//! radiance 1, seen straight on through a 1-degree field of view: every path crosses 2 units
-//! of the volume, so each pixel's expected value is attenuationColor^(2 / distance).
+//! The scene: a cube of side 2 (a glTF mesh, fully transmissive, roughness 0, ior 1.5) in
+//! front of an emitting wall of radiance 1, seen straight on through a 1-degree field of
+//! view. Seen face on, each face reflects F = 0.04 (Schlick's f0 at ior 1.5) and passes the
+//! rest without bending it, so light crossing the 2 units of volume once (T =
+//! attenuationColor^(2 / distance)), three times, ... reaches the camera:
+//! (1 - F)^2 T / (1 - F^2 T^2) per channel.
 
 mod common;
 
@@ -54,7 +56,7 @@ fn cube_bin() -> Vec<u8> {
 }
 
 /// `cube.gltf` in `dir`, with `volume` as its `KHR_materials_volume` object.
-fn write_cube(dir: &Path, volume: Value) {
+fn write_cube(dir: &Path, volume: Value, ior: f64) {
     let bin = cube_bin();
     std::fs::write(dir.join("cube.bin"), &bin).unwrap();
     let doc = json!({
@@ -71,7 +73,7 @@ fn write_cube(dir: &Path, volume: Value) {
             "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.0},
             "extensions": {
                 "KHR_materials_transmission": {"transmissionFactor": 1.0},
-                "KHR_materials_ior": {"ior": 1.0},
+                "KHR_materials_ior": {"ior": ior},
                 "KHR_materials_volume": volume
             }
         }],
@@ -110,16 +112,17 @@ fn attenuating() -> Value {
 #[test]
 fn light_through_a_volume_keeps_the_attenuation_colour_to_the_power_of_distance() {
     let dir = ScratchDir::new("gltf-volume-beer");
-    write_cube(&dir, attenuating());
+    write_cube(&dir, attenuating(), 1.5);
     let scene = load(&write_scene(&dir, None), &[], None).unwrap();
     // No integrator in the JSON: the glTF volume made it the volumetric path tracer.
     assert!(matches!(scene.integrator, Integrator::Volpath(_)), "{:?}", scene.integrator);
     let out = render_with(&scene.world, &scene.integrator, 256, 5);
     let k = z_critical(FALSE_ALARM, 3);
+    let f = 0.04;
     for (c, &color) in COLOR.iter().enumerate() {
-        // 2 units of volume; the slant of the 1-degree view adds at most 4e-5 of length,
-        // Schlick's reflection at ior 1 seen face on is below 1e-20.
-        let exact = color.powf(2.0 / DISTANCE);
+        // The slant of the 1-degree view adds at most 4e-5 to the length and 1e-21 to F.
+        let t = color.powf(2.0 / DISTANCE);
+        let exact = (1.0 - f) * (1.0 - f) * t / (1.0 - f * f * t * t);
         let e = image_estimate(&out, c);
         println!("channel {c}: {:.5} +- {:.5} (exact {exact:.5})", e.mean, e.se);
         assert!(e.se > 0.0 && e.se < 0.02 * exact, "channel {c}: standard error {}", e.se);
@@ -134,7 +137,8 @@ fn a_thin_wall_absorbs_nothing() {
     // sampling through the walls' nearly specular lobe adds rare large samples: the mean is
     // tested, within its standard error.)
     let dir = ScratchDir::new("gltf-volume-thin");
-    write_cube(&dir, json!({"thicknessFactor": 0.0, "attenuationColor": COLOR, "attenuationDistance": DISTANCE}));
+    // ior 1: nothing reflected face on.
+    write_cube(&dir, json!({"thicknessFactor": 0.0, "attenuationColor": COLOR, "attenuationDistance": DISTANCE}), 1.0);
     let scene = load(&write_scene(&dir, None), &[], None).unwrap();
     assert!(matches!(scene.integrator, Integrator::Path(_)), "{:?}", scene.integrator);
     let out = render_with(&scene.world, &scene.integrator, 64, 5);
@@ -150,7 +154,7 @@ fn a_thin_wall_absorbs_nothing() {
 #[test]
 fn an_integrator_without_media_is_warned_of_the_volume_it_ignores() {
     let dir = ScratchDir::new("gltf-volume-warning");
-    write_cube(&dir, attenuating());
+    write_cube(&dir, attenuating(), 1.5);
     let path = write_scene(&dir, Some(json!({"type": "path"})));
     let s = Session::open(&path, &ReadOptions::default()).unwrap();
     let d = s.description();

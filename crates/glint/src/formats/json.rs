@@ -1153,6 +1153,7 @@ fn medium_of(ctx: &Ctx, name: &str, m: &JsonMedium) -> Result<MediumDesc, Error>
         phase: m.phase.unwrap_or_default(),
         sample_emitters: m.sample_emitters.unwrap_or(true),
         density: None,
+        absorbing_only: false,
         loc: ctx.loc(&at),
     })
 }

@@ -306,6 +306,7 @@ fn volume_medium(g: &GltfMaterialDesc, name: &str, loc: &SourceLoc) -> Option<Me
         phase: PhaseDesc::Isotropic,
         sample_emitters: false,
         density: None,
+        absorbing_only: true,
         loc: loc.clone(),
     })
 }
