@@ -47,9 +47,9 @@ pub(crate) fn passes_mask(scene: &World, si: &SurfaceInteraction, dir: Vec3, pas
 
 /// The fraction of light that gets along a shadow ray: 1 when nothing blocks it, 0 when an
 /// opaque surface does, the product of (1 − opacity) over the masked surfaces (and culled
-/// back faces) it crosses
-/// otherwise (the expected value of passing each one, as Mitsuba's volumetric path tracer
-/// counts null surfaces; its `path` integrator stops shadow rays at every surface).
+/// back faces) it crosses otherwise (the expected value of passing each one, as Mitsuba's
+/// volumetric path tracer counts null surfaces; its `path` integrator stops shadow rays at
+/// every surface).
 pub(crate) fn transmittance(scene: &World, ray: &Ray, c: &mut Counters) -> f32 {
     transmittance_if_blocked(scene, ray, scene.occluded(ray), c)
 }
