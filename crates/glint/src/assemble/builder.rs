@@ -41,14 +41,19 @@ impl LoadedGroup {
     }
 }
 
-/// Reads an OBJ (one group per material) or PLY file and builds each group's BVH.
+/// Reads an OBJ (one group per material) or PLY file and builds each group's BVH;
+/// `reverse_winding` (glTF primitives only) reverses each triangle's vertex order.
 pub fn read_mesh_file(
     path: &Path,
     face_normals: bool,
     shape_index: u32,
+    reverse_winding: bool,
     split: BvhSplit,
 ) -> Result<Vec<LoadedGroup>, String> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if reverse_winding && !matches!(ext.as_str(), "gltf" | "glb") {
+        return Err(format!("{}: only glTF primitives are read with reversed winding", path.display()));
+    }
     match ext.as_str() {
         "serialized" => {
             let m = serialized::read_serialized(path, shape_index)?;
@@ -82,20 +87,36 @@ pub fn read_mesh_file(
                 .map_err(|e| format!("{}: {e}", path.display()))?;
             Ok(vec![LoadedGroup::primitive(mesh)])
         }
-        "gltf" | "glb" => Ok(vec![LoadedGroup::primitive(gltf_primitive(path, shape_index, face_normals, split)?)]),
+        "gltf" | "glb" => {
+            Ok(vec![LoadedGroup::primitive(gltf_primitive(path, shape_index, face_normals, reverse_winding, split)?)])
+        }
         _ => Err(format!("{}: unknown mesh format (expected .obj, .ply or .serialized)", path.display())),
     }
 }
 
 /// Primitive `flat` of a glTF file (see [`crate::io::gltf::GltfFile::primitive_at`]), with
-/// its second texture coordinate set and vertex colours as mesh attributes.
-fn gltf_primitive(path: &Path, flat: u32, face_normals: bool, split: BvhSplit) -> Result<TriangleMesh, String> {
+/// its second texture coordinate set, vertex colours and tangents as mesh attributes; `reverse` gives
+/// each triangle the opposite winding (for a placement by a mirroring transform).
+fn gltf_primitive(
+    path: &Path,
+    flat: u32,
+    face_normals: bool,
+    reverse: bool,
+    split: BvhSplit,
+) -> Result<TriangleMesh, String> {
     use crate::geometry::{AttributeScope, MeshAttribute};
-    use crate::materials::{ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, UV1_ATTRIBUTE};
+    use crate::materials::{
+        ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, TANGENT_ATTRIBUTE, TANGENT_SIGN_ATTRIBUTE, UV1_ATTRIBUTE,
+    };
     let at = |e: String| format!("{}: {e}", path.display());
     let f = crate::io::gltf::open_cached(path).map_err(at)?;
     let (mesh, prim) = f.primitive_at(flat as usize).ok_or_else(|| at(format!("no primitive {flat}")))?;
-    let p = crate::io::gltf::read_primitive(&f, mesh, prim).map_err(at)?;
+    let mut p = crate::io::gltf::read_primitive(&f, mesh, prim).map_err(at)?;
+    if reverse {
+        for t in &mut p.indices {
+            t.swap(1, 2);
+        }
+    }
     let attribute = |name: &str, dim: usize, values: Vec<f32>| MeshAttribute {
         name: name.into(),
         scope: AttributeScope::Vertex,
@@ -109,6 +130,10 @@ fn gltf_primitive(path: &Path, flat: u32, face_normals: bool, split: BvhSplit) -
     if let Some(c) = &p.colors {
         attributes.push(attribute(COLOR_ATTRIBUTE, 3, c.iter().flat_map(|c| [c[0], c[1], c[2]]).collect()));
         attributes.push(attribute(ALPHA_ATTRIBUTE, 1, c.iter().map(|c| c[3]).collect()));
+    }
+    if let Some(t) = &p.tangents {
+        attributes.push(attribute(TANGENT_ATTRIBUTE, 3, t.iter().flat_map(|t| [t[0], t[1], t[2]]).collect()));
+        attributes.push(attribute(TANGENT_SIGN_ATTRIBUTE, 1, t.iter().map(|t| t[3]).collect()));
     }
     let normals = if face_normals { None } else { p.normals };
     let ctx = format!("meshes[{mesh}].primitives[{prim}]");

@@ -11,7 +11,10 @@ use super::builder::{bake, environment_lights, read_mesh_file};
 use super::{add_light, camera, material_id, material_kind, mesh_loc, transform_of, validate, TextureCache};
 use super::{BuildOptions, LoadedGroup, WorldBuilder};
 use crate::accel::BvhSplit;
-use crate::describe::{CurveBasisDesc, Emission, Geometry, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc, ShapeDesc};
+use crate::describe::{
+    CurveBasisDesc, Emission, Geometry, MaterialDesc, MaterialModel, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc,
+    ShapeDesc,
+};
 use crate::error::{Error, SourceLoc};
 use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, CurveBasis, SdfNormals, TriangleMesh};
 use crate::lights::{AreaEmission, Light};
@@ -42,6 +45,7 @@ enum Source {
         file: PathBuf,
         face_normals: bool,
         shape_index: u32,
+        reverse_winding: bool,
     },
     /// An in-description mesh or a primitive, by shape index and a hash of its geometry (so
     /// a shape whose geometry was replaced is not served a stale mesh).
@@ -118,8 +122,7 @@ pub fn build_cached(
 
     let mut material_ids = Vec::with_capacity(desc.materials.len());
     for m in &desc.materials {
-        let kind = material_kind(&m.model, &mut textures).map_err(|e| e.or_at(&m.loc))?;
-        material_ids.push(b.add_material(Material::new(m.name.clone(), kind, m.two_sided)));
+        material_ids.push(b.add_material(material(m, &mut textures)?));
     }
     load_files(desc, opts.bvh_split, cache, &mut b)?;
     for m in super::media::media(desc)? {
@@ -152,32 +155,35 @@ pub fn build_cached(
 
 /// Loads the mesh files not yet cached, in parallel, each once.
 fn load_files(desc: &SceneDesc, split: BvhSplit, cache: &mut MeshCache, b: &mut WorldBuilder) -> Result<(), Error> {
-    let mut files: Vec<(PathBuf, bool, u32)> =
-        desc.meshes.iter().map(|m| (m.file.clone(), m.face_normals, m.shape_index)).collect();
+    let mut files: Vec<(PathBuf, bool, u32, bool)> =
+        desc.meshes.iter().map(|m| (m.file.clone(), m.face_normals, m.shape_index, m.reverse_winding)).collect();
     for s in &desc.shapes {
         if let Geometry::MeshFile { file, face_normals, shape_index } = &s.geometry {
-            files.push((file.clone(), *face_normals, *shape_index));
+            files.push((file.clone(), *face_normals, *shape_index, false));
         }
     }
     files.sort();
     files.dedup();
-    files.retain(|(file, face_normals, shape_index)| {
+    files.retain(|(file, face_normals, shape_index, reverse_winding)| {
         !cache.groups.contains_key(&Source::File {
             file: file.clone(),
             face_normals: *face_normals,
             shape_index: *shape_index,
+            reverse_winding: *reverse_winding,
         })
     });
     let start = std::time::Instant::now();
     let loaded: Vec<Result<Vec<LoadedGroup>, String>> = files
         .par_iter()
-        .map(|(file, face_normals, shape_index)| read_mesh_file(file, *face_normals, *shape_index, split))
+        .map(|(file, face_normals, shape_index, reverse)| {
+            read_mesh_file(file, *face_normals, *shape_index, *reverse, split)
+        })
         .collect();
     b.build_seconds += start.elapsed().as_secs_f64();
-    for ((file, face_normals, shape_index), result) in files.into_iter().zip(loaded) {
+    for ((file, face_normals, shape_index, reverse_winding), result) in files.into_iter().zip(loaded) {
         let groups = result.map_err(|e| Error::at(&mesh_loc(desc, &file), e))?;
         cache.counters.mesh_bvh_builds += groups.len() as u64;
-        cache.groups.insert(Source::File { file, face_normals, shape_index }, groups);
+        cache.groups.insert(Source::File { file, face_normals, shape_index, reverse_winding }, groups);
     }
     Ok(())
 }
@@ -205,13 +211,15 @@ fn add_shape(
     let emission = area_emission(s.emission.as_ref(), textures)?;
     let (source, instanced) = match &s.geometry {
         Geometry::MeshFile { file, face_normals, shape_index } => {
-            (Source::File { file: file.clone(), face_normals: *face_normals, shape_index: *shape_index }, false)
+            let (file, face_normals, shape_index) = (file.clone(), *face_normals, *shape_index);
+            (Source::File { file, face_normals, shape_index, reverse_winding: false }, false)
         }
         Geometry::Instance { mesh } => {
             let m = desc.meshes.get(*mesh).ok_or_else(|| {
                 Error::new(format!("mesh index {mesh} is out of range ({} meshes)", desc.meshes.len()))
             })?;
-            (Source::File { file: m.file.clone(), face_normals: m.face_normals, shape_index: m.shape_index }, true)
+            let (file, face_normals, shape_index) = (m.file.clone(), m.face_normals, m.shape_index);
+            (Source::File { file, face_normals, shape_index, reverse_winding: m.reverse_winding }, true)
         }
         Geometry::Sphere { center, radius } => {
             check_attributes(desc, s, None)?;
@@ -300,6 +308,16 @@ fn add_shape(
 }
 
 /// What a shape emits, its texture made (or found in the cache).
+/// A described material, built: its kind with textures loaded, its sides.
+fn material(m: &MaterialDesc, textures: &mut TextureCache) -> Result<Material, Error> {
+    let kind = material_kind(&m.model, textures).map_err(|e| e.or_at(&m.loc))?;
+    let mut out = Material::new(m.name.clone(), kind, m.two_sided);
+    if let MaterialModel::Gltf(g) = &m.model {
+        out.cull_back_faces = g.culls_back_faces();
+    }
+    Ok(out)
+}
+
 fn area_emission(e: Option<&Emission>, textures: &mut TextureCache) -> Result<Option<AreaEmission>, Error> {
     e.map(|e| Ok(AreaEmission { radiance: textures.texture(&e.radiance)?, two_sided: e.two_sided })).transpose()
 }
@@ -376,8 +394,7 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
     let mut textures = TextureCache::default();
     let mut materials = Vec::with_capacity(desc.materials.len());
     for m in &desc.materials {
-        let kind = material_kind(&m.model, &mut textures).map_err(|e| e.or_at(&m.loc))?;
-        materials.push(Material::new(m.name.clone(), kind, m.two_sided));
+        materials.push(material(m, &mut textures)?);
     }
     let mut b = WorldBuilder::new(world.bvh_split);
     for l in &desc.lights {

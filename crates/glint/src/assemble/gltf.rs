@@ -7,7 +7,7 @@ use crate::bsdf::GltfPbr;
 use crate::describe::{GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, TextureDesc};
 use crate::error::Error;
 use crate::io::gltf::{decode_image, image_bytes, open_cached, RgbaImage};
-use crate::materials::{GltfAlpha, GltfMaterial, GltfTexture, MaterialKind, Texture};
+use crate::materials::{GltfAlpha, GltfExtensionTextures, GltfMaterial, GltfTexture, MaterialKind, Texture};
 use std::sync::Arc;
 
 impl TextureCache {
@@ -63,6 +63,15 @@ pub(super) fn gltf_kind(g: &GltfMaterialDesc, textures: &mut TextureCache) -> Re
         factors,
         base_color_texture: base_color_texture.clone(),
         metallic_roughness_texture: textures.optional_gltf(&g.metallic_roughness_texture)?,
+        extension_textures: GltfExtensionTextures {
+            specular: textures.optional_gltf(&g.specular_texture)?,
+            specular_color: textures.optional_gltf(&g.specular_color_texture)?,
+            transmission: textures.optional_gltf(&g.transmission_texture)?,
+            clearcoat: textures.optional_gltf(&g.clearcoat_texture)?,
+            clearcoat_roughness: textures.optional_gltf(&g.clearcoat_roughness_texture)?,
+            sheen_color: textures.optional_gltf(&g.sheen_color_texture)?,
+            sheen_roughness: textures.optional_gltf(&g.sheen_roughness_texture)?,
+        },
         unlit: g.unlit,
     });
     if let Some(n) = textures.optional_gltf(&g.normal_texture)? {

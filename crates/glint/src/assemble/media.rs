@@ -60,6 +60,9 @@ fn medium(m: &MediumDesc) -> Result<(), String> {
         }
         VolumeDesc::Grid(_) => {}
     }
+    if m.absorbing_only && (m.density.is_some() || m.albedo != VolumeDesc::Constant(crate::math::Rgb::BLACK)) {
+        return Err("an absorbing-only medium must be homogeneous with albedo 0".into());
+    }
     if let PhaseDesc::Hg { g } = m.phase {
         if !(g > -1.0 && g < 1.0) {
             return Err(format!("hg: g {g} must lie in (-1, 1)"));
@@ -85,7 +88,9 @@ pub fn media(d: &SceneDesc) -> Result<Vec<Medium>, Error> {
                 )),
             };
             let Some(g) = &m.density else {
-                return Ok(Medium::new(m.sigma_t * m.scale, albedo, phase, m.sample_emitters));
+                let mut out = Medium::new(m.sigma_t * m.scale, albedo, phase, m.sample_emitters);
+                out.absorbing_only = m.absorbing_only;
+                return Ok(out);
             };
             let sigma_t = m.sigma_t.r * m.scale;
             let density = density_grid(g, sigma_t)
@@ -143,4 +148,28 @@ fn albedo_grid(g: &GridVolumeDesc) -> Result<GridVolume, String> {
 /// The media on the two sides of a shape, as the world indexes them.
 pub fn boundary(m: &crate::describe::ShapeMedia) -> MediumBoundary {
     MediumBoundary { interior: m.interior.map(|i| i as u32), exterior: m.exterior.map(|i| i as u32) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Rgb;
+
+    #[test]
+    fn an_absorbing_only_medium_must_scatter_nothing() {
+        let mut m = MediumDesc {
+            name: "ink".into(),
+            sigma_t: Rgb::splat(1.0),
+            albedo: VolumeDesc::Constant(Rgb::BLACK),
+            scale: 1.0,
+            phase: PhaseDesc::Isotropic,
+            sample_emitters: false,
+            density: None,
+            absorbing_only: true,
+            loc: SourceLoc::default(),
+        };
+        assert!(medium(&m).is_ok());
+        m.albedo = VolumeDesc::Constant(Rgb::splat(0.5));
+        assert!(medium(&m).unwrap_err().contains("absorbing-only"));
+    }
 }

@@ -89,6 +89,27 @@ pub struct GltfMaterialDesc {
     pub sheen_roughness: f32,
     /// `KHR_materials_unlit`: the base colour is emitted, nothing scatters.
     pub unlit: bool,
+    /// The extensions' textures, each multiplying its factor: `specularTexture` (alpha),
+    /// `specularColorTexture` (RGB, sRGB), `transmissionTexture` (red), `clearcoatTexture`
+    /// (red), `clearcoatRoughnessTexture` (green), `sheenColorTexture` (RGB, sRGB),
+    /// `sheenRoughnessTexture` (alpha), `thicknessTexture` (green; read, but a path tracer
+    /// measures a volume's thickness from its geometry, so it changes nothing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specular_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specular_color_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmission_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearcoat_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clearcoat_roughness_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sheen_color_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sheen_roughness_texture: Option<super::TextureDesc>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness_texture: Option<super::TextureDesc>,
 }
 
 impl GltfMaterialDesc {
@@ -118,21 +139,62 @@ impl GltfMaterialDesc {
             sheen_color: Rgb::BLACK,
             sheen_roughness: 0.0,
             unlit: false,
+            specular_texture: None,
+            specular_color_texture: None,
+            transmission_texture: None,
+            clearcoat_texture: None,
+            clearcoat_roughness_texture: None,
+            sheen_color_texture: None,
+            sheen_roughness_texture: None,
+            thickness_texture: None,
         }
     }
 
-    /// The textures, in a fixed order (base colour, metal/rough, normal).
+    /// Whether a ray meeting the surface's back face passes through it (the specification's
+    /// back-face culling for `doubleSided: false`): every single-sided surface but the
+    /// boundary of a volume (`KHR_materials_volume` with thickness > 0), which stays
+    /// two-sided as that extension says.
+    pub fn culls_back_faces(&self) -> bool {
+        !self.double_sided && self.thin_walled
+    }
+
+    /// The textures, in a fixed order (base colour, metal/rough, normal, then the
+    /// extensions' in the order of the fields).
     pub fn textures(&self) -> Vec<&super::TextureDesc> {
-        [&self.base_color_texture, &self.metallic_roughness_texture, &self.normal_texture]
-            .into_iter()
-            .flatten()
-            .collect()
+        [
+            &self.base_color_texture,
+            &self.metallic_roughness_texture,
+            &self.normal_texture,
+            &self.specular_texture,
+            &self.specular_color_texture,
+            &self.transmission_texture,
+            &self.clearcoat_texture,
+            &self.clearcoat_roughness_texture,
+            &self.sheen_color_texture,
+            &self.sheen_roughness_texture,
+            &self.thickness_texture,
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
     }
 
     pub fn textures_mut(&mut self) -> Vec<&mut super::TextureDesc> {
-        [&mut self.base_color_texture, &mut self.metallic_roughness_texture, &mut self.normal_texture]
-            .into_iter()
-            .flatten()
-            .collect()
+        [
+            &mut self.base_color_texture,
+            &mut self.metallic_roughness_texture,
+            &mut self.normal_texture,
+            &mut self.specular_texture,
+            &mut self.specular_color_texture,
+            &mut self.transmission_texture,
+            &mut self.clearcoat_texture,
+            &mut self.clearcoat_roughness_texture,
+            &mut self.sheen_color_texture,
+            &mut self.sheen_roughness_texture,
+            &mut self.thickness_texture,
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
     }
 }

@@ -29,6 +29,11 @@ pub struct MediumDesc {
     /// channel) that multiplies `sigma_t` (then grey) point by point; `None` is homogeneous.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<GridVolumeDesc>,
+    /// The medium only absorbs (homogeneous, constant albedo 0: glTF's
+    /// `KHR_materials_volume` attenuation): a path crossing it carries its transmittance
+    /// instead of ending where an absorption is sampled (the same expectation, no variance).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub absorbing_only: bool,
     #[serde(default)]
     pub loc: SourceLoc,
 }

@@ -336,6 +336,11 @@ pub struct MeshFileDesc {
     /// Which mesh of a `.serialized` file (Mitsuba's `shape_index`); 0 for other files.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub shape_index: u32,
+    /// The triangles are read with their winding reversed: a glTF primitive placed by a
+    /// mirroring transform (glTF keeps a face's front where the determinant is negative;
+    /// glint orients faces by their winding in world space). glTF files only.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub reverse_winding: bool,
 }
 
 /// Which material a shape uses.
@@ -889,6 +894,7 @@ mod tests {
             face_normals: false,
             loc: SourceLoc::default(),
             shape_index: 0,
+            reverse_winding: false,
         });
         for file in ["box.obj", "bunny.ply"] {
             d.shapes.push(ShapeDesc {

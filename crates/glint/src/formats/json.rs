@@ -783,9 +783,11 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
             face_normals: m.face_normals,
             loc: ctx.loc(&format!("meshes/{name}")),
             shape_index: 0,
+            reverse_winding: false,
         });
     }
 
+    let json_media = desc.media.len();
     for (i, s) in file.shapes.iter().enumerate() {
         if s.kind == "gltf" {
             let (gltf, part) = gltf_group(&ctx, i, s)?;
@@ -799,6 +801,21 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
         desc.shapes.push(shape);
     }
 
+    if desc.media.len() > json_media {
+        // A placed glTF file brought absorbing volumes (KHR_materials_volume): without an
+        // integrator of its own the scene gets the volumetric path tracer, which renders them.
+        match (&file.integrator, &desc.integrator) {
+            (None, _) => desc.integrator = IntegratorDesc::Volpath(VolpathSettings::default()),
+            (Some(_), IntegratorDesc::Volpath(_)) => {}
+            (Some(_), IntegratorDesc::Path(_) | IntegratorDesc::Direct(_) | IntegratorDesc::Whitted(_)) => {
+                desc.warnings.push(format!(
+                    "{}: a glTF file's absorbing volumes (KHR_materials_volume attenuation) are rendered only by the volpath integrator; the {} integrator ignores them",
+                    path.display(),
+                    desc.integrator.name()
+                ))
+            }
+        }
+    }
     for (i, l) in file.lights.iter().enumerate() {
         let at = format!("lights/{i}");
         desc.lights.push(LightDesc { light: light_of(&ctx, &at, l)?, name: None, loc: ctx.loc(&at) });
@@ -1136,6 +1153,7 @@ fn medium_of(ctx: &Ctx, name: &str, m: &JsonMedium) -> Result<MediumDesc, Error>
         phase: m.phase.unwrap_or_default(),
         sample_emitters: m.sample_emitters.unwrap_or(true),
         density: None,
+        absorbing_only: false,
         loc: ctx.loc(&at),
     })
 }

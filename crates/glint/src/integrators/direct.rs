@@ -36,7 +36,7 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
         let si = scene.interaction(&ray, &hit);
         // Only reached when emitters are shown (`camera_hit` looks through them otherwise).
         l += scene.emitted(&si, ray.dir);
-        if passes_mask(scene, &si, passes, rng) {
+        if passes_mask(scene, &si, ray.dir, passes, rng) {
             passes += 1;
             camera_ray = spawn_ray(&si, ray.dir);
             continue;
@@ -110,7 +110,7 @@ pub fn li(s: &DirectSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler
                             l += weight(light_pdf) * le * through;
                         }
                     }
-                    through *= 1.0 - if scene.has_masks { opacity(scene, &sj) } else { 1.0 };
+                    through *= 1.0 - if scene.has_masks { opacity(scene, &sj, ray.dir) } else { 1.0 };
                     if !(through > 0.0) {
                         break;
                     }

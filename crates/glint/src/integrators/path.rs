@@ -140,7 +140,7 @@ impl PathState {
         // A masked surface lets the path through unscattered with probability 1 - opacity.
         // Passing is not a bounce: depth, the MIS state and the previous vertex stay as
         // they were (shadow rays from that vertex crossed the surface the same way).
-        if passes_mask(scene, &si, self.mask_passes, rng) {
+        if passes_mask(scene, &si, ray.dir, self.mask_passes, rng) {
             self.mask_passes += 1;
             self.depth -= 1;
             self.ray = spawn_ray(&si, ray.dir);

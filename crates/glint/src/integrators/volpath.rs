@@ -125,7 +125,7 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
         // A masked surface lets the path through unscattered with probability 1 - opacity:
         // a passage, as in `path` (depth and the MIS state stay those of the last event).
         if scene.has_masks {
-            let o = opacity(scene, &si);
+            let o = opacity(scene, &si, ray.dir);
             if o < 1.0 && rng.next_f32() >= o {
                 passages += 1;
                 if passages > MAX_PASSAGES {
@@ -297,7 +297,7 @@ fn transmittance(
         let through = bsdf.bsdf.passage_transmission(frame.to_local(-ray.dir));
         // A mask passes 1 - opacity unscattered; the surface beneath it passes its share
         // of the rest if it is itself a passage.
-        let o = if scene.has_masks { opacity(scene, &si) } else { 1.0 };
+        let o = if scene.has_masks { opacity(scene, &si, ray.dir) } else { 1.0 };
         let pass = match through {
             Some(t) if o < 1.0 => t * o + Rgb::splat(1.0 - o),
             Some(t) => t,

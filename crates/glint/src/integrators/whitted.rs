@@ -174,7 +174,7 @@ fn scattering_hit(
         let hit = scene.intersect(&ray)?;
         let si = scene.interaction(&ray, &hit);
         *l += scene.emitted(&si, ray.dir);
-        if passes_mask(scene, &si, passes, rng) {
+        if passes_mask(scene, &si, ray.dir, passes, rng) {
             passes += 1;
             ray = spawn_ray(&si, ray.dir);
             continue;

@@ -13,6 +13,9 @@ use std::sync::Arc;
 pub const UV1_ATTRIBUTE: &str = "vertex_gltf_uv1";
 pub const COLOR_ATTRIBUTE: &str = "vertex_gltf_color";
 pub const ALPHA_ATTRIBUTE: &str = "vertex_gltf_alpha";
+/// `TANGENT`'s xyz (object space) and its w, the bitangent's sign.
+pub const TANGENT_ATTRIBUTE: &str = "vertex_gltf_tangent";
+pub const TANGENT_SIGN_ATTRIBUTE: &str = "vertex_gltf_tangent_sign";
 
 /// A glTF texture ready to sample.
 #[derive(Clone, Debug)]
@@ -176,13 +179,35 @@ fn vertex_value(p: &TexturePoint, name: &str) -> Option<Rgb> {
 /// A glTF material with its textures.
 #[derive(Clone, Debug)]
 pub struct GltfMaterial {
-    /// The material's factors and extensions; base colour, metallic and roughness are
-    /// multiplied by the textures at each hit.
+    /// The material's factors and extensions; each is multiplied by its texture's channel
+    /// at each hit.
     pub factors: GltfPbr,
     pub base_color_texture: Option<Arc<GltfTexture>>,
     pub metallic_roughness_texture: Option<Arc<GltfTexture>>,
+    /// The extensions' textures.
+    pub extension_textures: GltfExtensionTextures,
     /// `KHR_materials_unlit`: scatters nothing (the reader makes the surface emit).
     pub unlit: bool,
+}
+
+/// The textures of the KHR material extensions, each multiplying its factor by the channel
+/// the extension names.
+#[derive(Clone, Debug, Default)]
+pub struct GltfExtensionTextures {
+    /// `specularTexture`: alpha multiplies `specularFactor`.
+    pub specular: Option<Arc<GltfTexture>>,
+    /// `specularColorTexture` (sRGB): RGB multiplies `specularColorFactor`.
+    pub specular_color: Option<Arc<GltfTexture>>,
+    /// `transmissionTexture`: red multiplies `transmissionFactor`.
+    pub transmission: Option<Arc<GltfTexture>>,
+    /// `clearcoatTexture`: red multiplies `clearcoatFactor`.
+    pub clearcoat: Option<Arc<GltfTexture>>,
+    /// `clearcoatRoughnessTexture`: green multiplies `clearcoatRoughnessFactor`.
+    pub clearcoat_roughness: Option<Arc<GltfTexture>>,
+    /// `sheenColorTexture` (sRGB): RGB multiplies `sheenColorFactor`.
+    pub sheen_color: Option<Arc<GltfTexture>>,
+    /// `sheenRoughnessTexture`: alpha multiplies `sheenRoughnessFactor`.
+    pub sheen_roughness: Option<Arc<GltfTexture>>,
 }
 
 impl GltfMaterial {
@@ -201,6 +226,29 @@ impl GltfMaterial {
             let c = t.rgba_at(p);
             b.roughness *= c[1];
             b.metallic *= c[2];
+        }
+        let x = &self.extension_textures;
+        let read = |t: &Option<Arc<GltfTexture>>| t.as_ref().map(|t| t.rgba_at(p));
+        if let Some(c) = read(&x.specular) {
+            b.specular *= c[3];
+        }
+        if let Some(c) = read(&x.specular_color) {
+            b.specular_color *= rgb(c[0], c[1], c[2]);
+        }
+        if let Some(c) = read(&x.transmission) {
+            b.transmission *= c[0];
+        }
+        if let Some(c) = read(&x.clearcoat) {
+            b.clearcoat *= c[0];
+        }
+        if let Some(c) = read(&x.clearcoat_roughness) {
+            b.clearcoat_roughness *= c[1];
+        }
+        if let Some(c) = read(&x.sheen_color) {
+            b.sheen_color *= rgb(c[0], c[1], c[2]);
+        }
+        if let Some(c) = read(&x.sheen_roughness) {
+            b.sheen_roughness *= c[3];
         }
         b
     }

@@ -9,7 +9,10 @@ mod roughness;
 mod surface;
 mod texture;
 pub use blend::{BlendMaterial, BlendMaterialPart};
-pub use gltf::{GltfAlpha, GltfMaterial, GltfTexture, ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, UV1_ATTRIBUTE};
+pub use gltf::{
+    GltfAlpha, GltfExtensionTextures, GltfMaterial, GltfTexture, ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, TANGENT_ATTRIBUTE,
+    TANGENT_SIGN_ATTRIBUTE, UV1_ATTRIBUTE,
+};
 pub use principled::PrincipledMaterial;
 pub use roughness::RoughnessMap;
 pub use surface::Perturbation;
@@ -113,11 +116,16 @@ pub struct Material {
     /// Opaque materials scatter on both faces when true; otherwise the back face is black
     /// (Mitsuba's default, undone there by `twosided`). Dielectrics ignore this.
     pub two_sided: bool,
+    /// The back face is not there (glTF's `doubleSided: false`): a ray that meets the
+    /// surface from behind its geometric normal passes through it unscattered, as through a
+    /// fully transparent mask (see `integrators::surface::opacity`). False for every
+    /// material but single-sided glTF ones that do not bound a volume.
+    pub cull_back_faces: bool,
 }
 
 impl Material {
     pub fn new(name: impl Into<String>, kind: MaterialKind, two_sided: bool) -> Material {
-        Material { name: name.into(), kind, two_sided }
+        Material { name: name.into(), kind, two_sided, cull_back_faces: false }
     }
 
     pub fn plastic(diffuse: Texture, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> MaterialKind {

@@ -71,6 +71,12 @@ impl Material {
         self.kind.wrappers().any(|k| matches!(k, MaterialKind::Mask { .. }))
     }
 
+    /// True when rays may pass the surface unscattered: it has a mask, or its back faces
+    /// are culled ([`Material::cull_back_faces`]).
+    pub fn may_pass_rays(&self) -> bool {
+        self.cull_back_faces || self.is_masked()
+    }
+
     /// Probability that light meeting the surface at `p` scatters off it rather than passing
     /// straight through: the product of the masks' opacities (luminance of the texture,
     /// clamped to [0, 1] as Mitsuba does; NaN counts as opaque); 1 without a mask.

@@ -28,6 +28,9 @@ pub struct Medium {
     /// Heterogeneous media: the density (a grey grid) that multiplies `sigma_t` (then grey),
     /// with its majorant `sigma_t * max(density)`.
     pub density: Option<Density>,
+    /// Crossed without sampling a distance (a homogeneous medium that scatters nothing:
+    /// see [`sample_distance`]).
+    pub absorbing_only: bool,
 }
 
 /// A heterogeneous medium's density grid and the extinction bound tracking uses. Outside
@@ -75,7 +78,7 @@ impl Albedo {
 
 impl Medium {
     pub fn new(sigma_t: Rgb, albedo: Albedo, phase: Phase, sample_emitters: bool) -> Medium {
-        Medium { sigma_t, albedo, phase, sample_emitters, density: None }
+        Medium { sigma_t, albedo, phase, sample_emitters, density: None, absorbing_only: false }
     }
 
     /// A heterogeneous medium: grey extinction `sigma_t * density(p)`.
@@ -93,6 +96,7 @@ impl Medium {
             phase,
             sample_emitters,
             density: Some(Density { grid: density, majorant }),
+            absorbing_only: false,
         }
     }
 
@@ -204,9 +208,18 @@ pub struct FreeFlight {
 /// at the majorant's rate, each real with probability sigma_t(p) / majorant; the extinction
 /// being grey, every channel has the same density and the outcome weighs the albedo at a
 /// scattering point, 1 at the surface.
+///
+/// A medium marked `absorbing_only` (homogeneous, albedo 0) is crossed without a distance
+/// drawn: a collision there could only end the path, so every channel's strategy is given the
+/// same certain outcome (density 1) and the path carries the transmittance to the surface,
+/// the same expectation with no variance. Other media that happen to have albedo 0 keep
+/// free-flight sampling.
 pub fn sample_distance(m: &Medium, ray: &Ray, t_max: f32, channel: usize, rng: &mut Sampler) -> FreeFlight {
     if let Some(d) = &m.density {
         return delta_tracking(m, d, ray, t_max, rng);
+    }
+    if m.absorbing_only {
+        return FreeFlight { t: None, value: m.transmittance(t_max), density: Rgb::WHITE };
     }
     let u = rng.next_f32();
     let sigma = m.sigma_t.channel(channel.min(2));
@@ -246,7 +259,7 @@ fn delta_tracking(m: &Medium, d: &Density, ray: &Ray, t_max: f32, rng: &mut Samp
 mod tests {
     use super::*;
     use crate::describe::{GridFilter, GridWrap};
-    use crate::math::{vec3, Transform};
+    use crate::math::{rgb, vec3, Transform};
     use crate::sampling::SamplerKind;
 
     /// A slab along x over [0, 1): two cells (nearest) of density 0.5 and 1, sigma_t 2:
@@ -259,6 +272,28 @@ mod tests {
     }
 
     const N: usize = 40_000;
+
+    #[test]
+    fn an_absorbing_only_medium_is_crossed_carrying_its_transmittance() {
+        let sigma = rgb(0.5, 1.0, 2.0);
+        let mut m = Medium::new(sigma, Albedo::Constant(Rgb::BLACK), Phase::Isotropic, false);
+        let ray = Ray::new(vec3(0.0, 0.0, 0.0), vec3(0.0, 0.0, 1.0));
+        let mut rng = Sampler::new(SamplerKind::Independent, 3, 0, 0);
+        // Marked: the surface is always reached, the path weighed by exp(-sigma t) per channel
+        // and every channel's density 1 (the same outcome for all). No random number is used.
+        m.absorbing_only = true;
+        for channel in 0..3 {
+            let f = sample_distance(&m, &ray, 1.5, channel, &mut rng);
+            assert!(f.t.is_none());
+            assert_eq!(f.value, m.transmittance(1.5));
+            assert_eq!(f.density, Rgb::WHITE);
+        }
+        // Unmarked, the same medium samples distances: some paths are absorbed.
+        m.absorbing_only = false;
+        let absorbed = (0..1000).filter(|_| sample_distance(&m, &ray, 1.5, 2, &mut rng).t.is_some()).count();
+        // exp(-2 x 1.5) = 0.05 pass: about 950 of 1000 collide.
+        assert!((900..1000).contains(&absorbed), "{absorbed}");
+    }
 
     #[test]
     fn ratio_tracking_through_a_slab_averages_exp_minus_tau() {

@@ -123,7 +123,8 @@ pub struct World {
     pub(crate) light_selection: LightSelection,
     pub(crate) bvh_split: BvhSplit,
     pub(crate) bvh_build_seconds: f64,
-    /// Some material has a mask (`mask`): shadow rays then look past what they hit.
+    /// Some material has a mask (`mask`) or culled back faces (single-sided glTF): rays
+    /// then look past what they hit.
     pub(crate) has_masks: bool,
     /// Some material is a passage for volpath (`null`, `thindielectric`): its shadow rays
     /// then look past what they hit. Kept here so that no path scans the materials.
@@ -173,7 +174,7 @@ impl World {
 
     /// Sets the flags that say which materials the scene has; called whenever they change.
     pub(crate) fn update_material_flags(&mut self) {
-        self.has_masks = self.materials.iter().any(Material::is_masked);
+        self.has_masks = self.materials.iter().any(Material::may_pass_rays);
         self.has_passage_materials =
             self.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }));
     }

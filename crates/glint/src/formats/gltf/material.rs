@@ -3,8 +3,8 @@
 //! shapes that use it.
 
 use crate::describe::{
-    Emission, GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, GltfWrap, MaterialDesc, MaterialModel, SceneDesc,
-    TextureDesc,
+    Emission, GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, GltfWrap, MaterialDesc, MaterialModel, MediumDesc,
+    PhaseDesc, SceneDesc, TextureDesc, VolumeDesc,
 };
 use crate::error::SourceLoc;
 use crate::io::gltf::{GltfFile, Node};
@@ -13,10 +13,13 @@ use serde_json::Value;
 use std::cell::Cell;
 use std::path::Path;
 
-/// The description's material for each glTF material, and the emission of each.
+/// The description's material for each glTF material, the emission of each, and the
+/// medium inside each that bounds an absorbing volume.
 pub struct Materials {
     pub index: Vec<usize>,
     pub emission: Vec<Option<Emission>>,
+    /// Index into the description's media: `KHR_materials_volume`'s attenuation inside.
+    pub interior: Vec<Option<usize>>,
     default: Cell<Option<usize>>,
 }
 
@@ -186,8 +189,14 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
             return Err(format!("{p}.ior: {ior} is less than 1"));
         }
     }
+    // An extension's texture `key` of `n` (at `p`), if it has one.
+    let ext_tex = |n: &Node, p: &str, key: &str, srgb: bool| -> Result<Option<TextureDesc>, String> {
+        n.get(key).map(|t| tex(t, &format!("{p}.{key}"), srgb)).transpose()
+    };
     if let Some((v, p)) = e("KHR_materials_transmission") {
-        g.transmission = unit(&Node::new(v, &p), "transmissionFactor", 0.0)?;
+        let n = Node::new(v, &p);
+        g.transmission = unit(&n, "transmissionFactor", 0.0)?;
+        g.transmission_texture = ext_tex(&n, &p, "transmissionTexture", false)?;
     }
     if let Some((v, p)) = e("KHR_materials_volume") {
         let n = Node::new(v, &p);
@@ -200,6 +209,7 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
             return Err(format!("{p}.attenuationDistance: {dist} must be positive"));
         }
         g.attenuation_distance = dist.min(f32::MAX as f64) as f32;
+        g.thickness_texture = ext_tex(&n, &p, "thicknessTexture", false)?;
     }
     if let Some((v, p)) = e("KHR_materials_specular") {
         let n = Node::new(v, &p);
@@ -209,17 +219,23 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
             return Err(format!("{p}.specularColorFactor: components must not be negative"));
         }
         g.specular_color = rgb(c[0] as f32, c[1] as f32, c[2] as f32);
+        g.specular_texture = ext_tex(&n, &p, "specularTexture", false)?;
+        g.specular_color_texture = ext_tex(&n, &p, "specularColorTexture", true)?;
     }
     if let Some((v, p)) = e("KHR_materials_clearcoat") {
         let n = Node::new(v, &p);
         g.clearcoat = unit(&n, "clearcoatFactor", 0.0)?;
         g.clearcoat_roughness = unit(&n, "clearcoatRoughnessFactor", 0.0)?;
+        g.clearcoat_texture = ext_tex(&n, &p, "clearcoatTexture", false)?;
+        g.clearcoat_roughness_texture = ext_tex(&n, &p, "clearcoatRoughnessTexture", false)?;
     }
     if let Some((v, p)) = e("KHR_materials_sheen") {
         let n = Node::new(v, &p);
         let c = color(&n, "sheenColorFactor", [0.0; 4], 3)?;
         g.sheen_color = rgb(c[0], c[1], c[2]);
         g.sheen_roughness = unit(&n, "sheenRoughnessFactor", 0.0)?;
+        g.sheen_color_texture = ext_tex(&n, &p, "sheenColorTexture", true)?;
+        g.sheen_roughness_texture = ext_tex(&n, &p, "sheenRoughnessTexture", false)?;
     }
     g.unlit = e("KHR_materials_unlit").is_some();
     // Emission: factor x strength, textured or not.
@@ -247,7 +263,7 @@ fn material(file: &GltfFile, path: &Path, mi: usize) -> Result<(GltfMaterialDesc
 
 /// Every material of the file, added to the description in the file's order.
 pub fn materials(file: &GltfFile, path: &Path, d: &mut SceneDesc) -> Result<Materials, String> {
-    let mut out = Materials { index: Vec::new(), emission: Vec::new(), default: Cell::new(None) };
+    let mut out = Materials { index: Vec::new(), emission: Vec::new(), interior: Vec::new(), default: Cell::new(None) };
     let loc = SourceLoc::file(path);
     for mi in 0..file.array("materials").len() {
         let (g, emissive_texture, emissive) = material(file, path, mi)?;
@@ -259,10 +275,40 @@ pub fn materials(file: &GltfFile, path: &Path, d: &mut SceneDesc) -> Result<Mate
         let emission = emission(&g, emissive_texture, emissive);
         out.index.push(d.materials.len());
         out.emission.push(emission);
+        out.interior.push(volume_medium(&g, &name, &loc).map(|m| {
+            d.media.push(m);
+            d.media.len() - 1
+        }));
         let two_sided = g.double_sided;
         d.materials.push(MaterialDesc { name, model: MaterialModel::Gltf(g), two_sided, loc: loc.clone() });
     }
     Ok(out)
+}
+
+/// The absorbing medium inside a `KHR_materials_volume` boundary (thickness > 0) that lets
+/// light in (transmission > 0) and attenuates (a finite `attenuationDistance`, an
+/// `attenuationColor` below 1 in some channel): Beer-Lambert absorption, sigma_a =
+/// -ln(attenuationColor) / attenuationDistance per channel (a channel of colour 0 absorbs at
+/// glint's largest extinction), nothing scattered.
+fn volume_medium(g: &GltfMaterialDesc, name: &str, loc: &SourceLoc) -> Option<MediumDesc> {
+    let absorbs = g.attenuation_color.to_array().iter().any(|&c| c < 1.0);
+    if g.thin_walled || !(g.transmission > 0.0) || !(g.attenuation_distance < f32::MAX) || !absorbs {
+        return None;
+    }
+    let d = g.attenuation_distance as f64;
+    let sigma = |c: f32| ((-(c as f64).ln() / d).min(crate::assemble::MAX_EXTINCTION as f64) as f32).max(0.0);
+    let c = g.attenuation_color;
+    Some(MediumDesc {
+        name: format!("{name} (KHR_materials_volume)"),
+        sigma_t: crate::math::rgb(sigma(c.r), sigma(c.g), sigma(c.b)),
+        albedo: VolumeDesc::Constant(Rgb::BLACK),
+        scale: 1.0,
+        phase: PhaseDesc::Isotropic,
+        sample_emitters: false,
+        density: None,
+        absorbing_only: true,
+        loc: loc.clone(),
+    })
 }
 
 /// What a material's surfaces emit: the emissive colour (times its texture), or for an

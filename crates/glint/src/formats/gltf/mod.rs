@@ -10,7 +10,9 @@ mod lights;
 mod material;
 mod scene;
 
-use crate::describe::{CameraDesc, FilmDesc, Matrix4, PixelFilter, SceneDesc, IDENTITY};
+use crate::describe::{
+    CameraDesc, FilmDesc, IntegratorDesc, Matrix4, PixelFilter, SceneDesc, VolpathSettings, IDENTITY,
+};
 use crate::error::{Error, SourceLoc};
 use crate::io::gltf::GltfFile;
 use serde_json::Value;
@@ -76,6 +78,11 @@ fn describe_placed(
     let walk = scene::place(file, path, to_world, &mut d, &materials, &mut warnings)?;
     if let Some(camera) = camera {
         camera::choose(file, &walk, camera, &mut d, &mut warnings)?;
+        // Absorbing volumes (KHR_materials_volume attenuation) are media: rendered by the
+        // volumetric path tracer, which is the path tracer where there are none.
+        if !d.media.is_empty() {
+            d.integrator = IntegratorDesc::Volpath(VolpathSettings::default());
+        }
     }
     lights::punctual(file, &walk, &mut d)?;
     d.summary = walk.summary(file, &d, &warnings);

@@ -155,7 +155,9 @@ struct PrimitiveInfo {
     points: Vec<crate::math::Vec3>,
     triangles: usize,
     material: Option<usize>,
-    desc_mesh: Option<usize>,
+    /// The description's mesh of this primitive, as in the file and with its winding
+    /// reversed (for placements by a mirroring transform), once placed so.
+    desc_mesh: [Option<usize>; 2],
 }
 
 fn mesh_primitives(file: &GltfFile, mesh: usize, first_flat: usize) -> Result<Vec<PrimitiveInfo>, String> {
@@ -189,9 +191,19 @@ fn mesh_primitives(file: &GltfFile, mesh: usize, first_flat: usize) -> Result<Ve
             let points = data.positions.iter().zip(used).filter(|(_, u)| *u).map(|(p, _)| *p).collect();
             (points, data.indices.len())
         };
-        out.push(PrimitiveInfo { flat: first_flat + k, mode, points, triangles, material, desc_mesh: None });
+        out.push(PrimitiveInfo { flat: first_flat + k, mode, points, triangles, material, desc_mesh: [None; 2] });
     }
     Ok(out)
+}
+
+/// Whether `m` mirrors (its linear part has a negative determinant). glTF then keeps each
+/// face's front on the side the mirrored normal points to (the winding in world space turns
+/// clockwise), where glint orients a face by its winding in world space: such a placement
+/// uses the primitive with its winding reversed.
+fn mirrors(m: &Matrix4) -> bool {
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    det < 0.0
 }
 
 /// The world bounds of points under `m`.
@@ -279,26 +291,34 @@ pub fn place(
                 if info.triangles == 0 {
                     continue;
                 }
-                let mesh_index = *info.desc_mesh.get_or_insert_with(|| {
-                    d.meshes.push(MeshFileDesc {
-                        name: format!("mesh {mesh} primitive {}", info.flat - first_flat[mesh]),
-                        file: path.to_path_buf(),
-                        face_normals: false,
-                        loc: loc.clone(),
-                        shape_index: info.flat as u32,
-                    });
-                    d.meshes.len() - 1
-                });
-                let (material, emission) = match info.material {
-                    Some(m) => (MaterialRef::Index(materials.index[m]), materials.emission[m].clone()),
-                    None => (MaterialRef::Index(materials.default_material(d)), None),
+                let (material, emission, interior) = match info.material {
+                    Some(m) => {
+                        (MaterialRef::Index(materials.index[m]), materials.emission[m].clone(), materials.interior[m])
+                    }
+                    None => (MaterialRef::Index(materials.default_material(d)), None, None),
                 };
                 for inst in &instances {
                     if d.shapes.len() >= MAX_INSTANCES {
                         return Err(format!("{np}: more than {MAX_INSTANCES} instances in the scene"));
                     }
                     let to_world = mul(&world, inst);
-                    d.shapes.push(shape(mesh_index, to_world, material, emission.clone(), &loc));
+                    let reversed = mirrors(&to_world);
+                    let mesh_index = *info.desc_mesh[reversed as usize].get_or_insert_with(|| {
+                        let prim = info.flat - first_flat[mesh];
+                        d.meshes.push(MeshFileDesc {
+                            name: format!("mesh {mesh} primitive {prim}{}", if reversed { " (mirrored)" } else { "" }),
+                            file: path.to_path_buf(),
+                            face_normals: false,
+                            loc: loc.clone(),
+                            shape_index: info.flat as u32,
+                            reverse_winding: reversed,
+                        });
+                        d.meshes.len() - 1
+                    });
+                    let mut s = shape(mesh_index, to_world, material, emission.clone(), &loc);
+                    // A volume's absorbing medium inside; outside, none (vacuum).
+                    s.media.interior = interior;
+                    d.shapes.push(s);
                     walk.primitives += 1;
                     walk.triangles += info.triangles as u64;
                     let wb = transform_bounds(&info.points, &to_world);

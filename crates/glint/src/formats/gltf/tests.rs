@@ -167,6 +167,105 @@ fn a_shared_mesh_is_one_mesh_placed_twice() {
 }
 
 #[test]
+fn a_mirroring_placement_uses_the_primitive_with_its_winding_reversed() {
+    // Mirrored in x (negative determinant): glTF keeps the front where the mirrored normal
+    // points, so that placement reads the primitive with its triangles reversed; the
+    // unmirrored one and a rotation (positive determinant) share the primitive as it is.
+    let d = triangle_doc(
+        json!({}),
+        json!({"nodes": [{"mesh": 0}, {"mesh": 0, "scale": [-1, 1, 1]}, {"mesh": 0, "rotation": [0, 0, 1, 0]}],
+               "scenes": [{"nodes": [0, 1, 2]}]}),
+    );
+    let s = scene(&d).unwrap();
+    assert_eq!(s.meshes.len(), 2);
+    let mesh = |i: usize| match s.shapes[i].geometry {
+        Geometry::Instance { mesh } => &s.meshes[mesh],
+        _ => panic!("shape {i} is not an instance"),
+    };
+    assert!(!mesh(0).reverse_winding && mesh(1).reverse_winding && !mesh(2).reverse_winding);
+    assert_eq!(mesh(0).shape_index, mesh(1).shape_index);
+}
+
+/// A triangle with one material whose `extensions` are `ext`.
+fn material_doc(ext: Value) -> Value {
+    triangle_doc(
+        json!({}),
+        json!({"materials": [{"name": "glass", "extensions": ext}],
+               "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+               "nodes": [{"mesh": 0}]}),
+    )
+}
+
+#[test]
+fn an_attenuating_volume_is_an_absorbing_medium_inside_its_surface() {
+    use crate::describe::{IntegratorDesc, VolumeDesc};
+    let volume = |v: Value| {
+        material_doc(json!({"KHR_materials_transmission": {"transmissionFactor": 0.5}, "KHR_materials_volume": v}))
+    };
+    let s =
+        scene(&volume(json!({"thicknessFactor": 1, "attenuationColor": [0.5, 1.0, 0.0], "attenuationDistance": 4})))
+            .unwrap();
+    assert_eq!(s.media.len(), 1);
+    let m = &s.media[0];
+    // sigma_a = -ln(colour) / distance; colour 0 absorbs at the largest extinction allowed.
+    assert!((m.sigma_t.r - std::f32::consts::LN_2 / 4.0).abs() < 1e-7, "{:?}", m.sigma_t);
+    assert_eq!(m.sigma_t.g, 0.0);
+    assert_eq!(m.sigma_t.b, crate::assemble::MAX_EXTINCTION);
+    assert_eq!(m.albedo, VolumeDesc::Constant(crate::math::Rgb::BLACK));
+    assert_eq!((s.shapes[0].media.interior, s.shapes[0].media.exterior), (Some(0), None));
+    assert!(matches!(s.integrator, IntegratorDesc::Volpath(_)), "{:?}", s.integrator);
+    // No medium (and the path tracer) for a thin wall, no attenuation, or no transmission.
+    for d in [
+        volume(json!({"thicknessFactor": 0, "attenuationColor": [0.5, 0.5, 0.5], "attenuationDistance": 4})),
+        volume(json!({"thicknessFactor": 1, "attenuationColor": [0.5, 0.5, 0.5]})),
+        volume(json!({"thicknessFactor": 1, "attenuationColor": [1, 1, 1], "attenuationDistance": 4})),
+        material_doc(json!({"KHR_materials_volume":
+            {"thicknessFactor": 1, "attenuationColor": [0.5, 0.5, 0.5], "attenuationDistance": 4}})),
+    ] {
+        let s = scene(&d).unwrap();
+        assert!(s.media.is_empty() && s.shapes[0].media.interior.is_none());
+        assert!(matches!(s.integrator, IntegratorDesc::Path(_)));
+    }
+}
+
+#[test]
+fn extension_textures_are_read_with_their_colour_spaces_and_errors_name_them() {
+    use crate::describe::{MaterialModel, TextureDesc};
+    let t = |i: usize| json!({"index": i});
+    let with_textures = |ext: Value| {
+        let mut d = material_doc(ext);
+        d["images"] = json!([{"uri": "a.png"}, {"uri": "b.png"}]);
+        d["textures"] = json!([{"source": 0}, {"source": 1}]);
+        d
+    };
+    let s = scene(&with_textures(json!({
+        "KHR_materials_specular": {"specularTexture": t(0), "specularColorTexture": t(1)},
+        "KHR_materials_transmission": {"transmissionTexture": t(0)},
+        "KHR_materials_clearcoat": {"clearcoatTexture": t(1), "clearcoatRoughnessTexture": t(0)},
+        "KHR_materials_sheen": {"sheenColorTexture": t(0), "sheenRoughnessTexture": t(1)},
+        "KHR_materials_volume": {"thicknessTexture": {"index": 1, "texCoord": 1}}
+    })))
+    .unwrap();
+    let MaterialModel::Gltf(g) = &s.materials[0].model else { panic!("not a glTF material") };
+    let read = |t: &Option<TextureDesc>| match t {
+        Some(TextureDesc::Gltf(t)) => (t.image, t.srgb, t.texcoord),
+        other => panic!("{other:?}"),
+    };
+    // (image, sRGB, texture coordinate set): colours are sRGB, the rest linear.
+    assert_eq!(read(&g.specular_texture), (0, false, 0));
+    assert_eq!(read(&g.specular_color_texture), (1, true, 0));
+    assert_eq!(read(&g.transmission_texture), (0, false, 0));
+    assert_eq!(read(&g.clearcoat_texture), (1, false, 0));
+    assert_eq!(read(&g.clearcoat_roughness_texture), (0, false, 0));
+    assert_eq!(read(&g.sheen_color_texture), (0, true, 0));
+    assert_eq!(read(&g.sheen_roughness_texture), (1, false, 0));
+    assert_eq!(read(&g.thickness_texture), (1, false, 1));
+    assert_eq!(g.textures().len(), 8);
+    let e = scene(&with_textures(json!({"KHR_materials_sheen": {"sheenColorTexture": t(7)}}))).unwrap_err();
+    assert!(e.starts_with("materials[0].extensions.KHR_materials_sheen.sheenColorTexture.index: "), "{e}");
+}
+
+#[test]
 fn errors_name_the_json_path() {
     // POSITION's accessor claims 4 vertices; the buffer holds 3.
     let mut d = triangle_doc(json!({"mesh": 0}), json!({}));

@@ -92,6 +92,7 @@ impl<'a> Reader<'a> {
             face_normals,
             loc: el.loc(),
             shape_index,
+            reverse_winding: false,
         });
         self.meshes.len() - 1
     }

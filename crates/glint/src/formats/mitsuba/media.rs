@@ -161,7 +161,17 @@ impl<'a> Reader<'a> {
         }
         self.warn_unused(&p);
         let name = el.attr("id").map_or_else(|| format!("medium@{}:{}", el.file.display(), el.line), str::to_string);
-        Ok(MediumDesc { name, sigma_t, albedo, scale, phase, sample_emitters, density, loc: el.loc() })
+        Ok(MediumDesc {
+            name,
+            sigma_t,
+            albedo,
+            scale,
+            phase,
+            sample_emitters,
+            density,
+            absorbing_only: false,
+            loc: el.loc(),
+        })
     }
 
     /// A `constvolume`'s value (its `value`, a colour; 1 by default).
