@@ -8,9 +8,7 @@ use crate::math::{Mat4, Transform};
 use crate::media::{Albedo, GridVolume, Medium, MediumBoundary, Phase};
 use std::sync::Arc;
 
-/// The largest extinction (per unit length, after `scale`) a medium may have: denser ones
-/// would make paths of billions of tiny steps.
-pub const MAX_EXTINCTION: f32 = 1e9;
+use crate::describe::limits::MAX_EXTINCTION;
 
 pub fn check(d: &SceneDesc) -> Result<(), Error> {
     for m in &d.media {

@@ -13,7 +13,6 @@ mod validate;
 pub use builder::{LoadedGroup, WorldBuilder};
 pub(crate) use driver::patch_appearance;
 pub use driver::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
-pub(crate) use media::MAX_EXTINCTION;
 
 use crate::accel::BvhSplit;
 use crate::bsdf::PrincipledRates;

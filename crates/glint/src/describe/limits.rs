@@ -10,6 +10,9 @@ pub const MAX_SPP: u32 = 1 << 24;
 pub const MAX_WHITTED_DEPTH: u32 = 1 << 16;
 /// The most light or BSDF samples the direct integrator may take per camera sample.
 pub const MAX_DIRECT_SAMPLES: u32 = 1 << 12;
+/// The largest extinction (per unit length, after `scale`) a medium may have: denser ones
+/// would make paths of billions of tiny steps.
+pub const MAX_EXTINCTION: f32 = 1e9;
 
 /// Rejects zero and absurd resolutions.
 pub fn check_resolution(w: u32, h: u32) -> Result<(), String> {

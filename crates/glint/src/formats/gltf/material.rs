@@ -296,7 +296,7 @@ fn volume_medium(g: &GltfMaterialDesc, name: &str, loc: &SourceLoc) -> Option<Me
         return None;
     }
     let d = g.attenuation_distance as f64;
-    let sigma = |c: f32| ((-(c as f64).ln() / d).min(crate::assemble::MAX_EXTINCTION as f64) as f32).max(0.0);
+    let sigma = |c: f32| ((-(c as f64).ln() / d).min(crate::describe::limits::MAX_EXTINCTION as f64) as f32).max(0.0);
     let c = g.attenuation_color;
     Some(MediumDesc {
         name: format!("{name} (KHR_materials_volume)"),

@@ -210,7 +210,7 @@ fn an_attenuating_volume_is_an_absorbing_medium_inside_its_surface() {
     // sigma_a = -ln(colour) / distance; colour 0 absorbs at the largest extinction allowed.
     assert!((m.sigma_t.r - std::f32::consts::LN_2 / 4.0).abs() < 1e-7, "{:?}", m.sigma_t);
     assert_eq!(m.sigma_t.g, 0.0);
-    assert_eq!(m.sigma_t.b, crate::assemble::MAX_EXTINCTION);
+    assert_eq!(m.sigma_t.b, crate::describe::limits::MAX_EXTINCTION);
     assert_eq!(m.albedo, VolumeDesc::Constant(crate::math::Rgb::BLACK));
     assert_eq!((s.shapes[0].media.interior, s.shapes[0].media.exterior), (Some(0), None));
     assert!(matches!(s.integrator, IntegratorDesc::Volpath(_)), "{:?}", s.integrator);
