@@ -54,6 +54,7 @@ fn load(format: &str, data: &[u8], path: &Path) -> Result<(), String> {
         "pfm" => image_io::read_pfm_bytes(data, path).map(drop),
         "png" => image_io::decode_raster_bytes(data, path).map(drop),
         "mitsuba" => mitsuba_scene(data, path),
+        "gltf" => gltf_scene(path),
         other => panic!("unknown corpus folder '{other}'"),
     }
 }
@@ -69,6 +70,13 @@ fn mitsuba_scene(data: &[u8], path: &Path) -> Result<(), String> {
         .map(|(i, p)| (PathBuf::from(format!("/fuzz/inc{}.xml", i + 1)), String::from_utf8_lossy(p).into_owned()))
         .collect();
     glint::formats::mitsuba::read_str_with_includes(&scene, path, &[], &files).map(drop).map_err(|e| e.to_string())
+}
+
+/// A `.gltf` or `.glb` file read and built as `glint render` does (its primitives, images
+/// and textures are read by the build), so every size it claims meets its bound.
+fn gltf_scene(path: &Path) -> Result<(), String> {
+    let desc = glint::formats::gltf::read(path, None).map_err(|e| e.to_string())?;
+    glint::assemble::build(&desc, &Default::default()).map(drop).map_err(|e| e.to_string())
 }
 
 /// Runs one case on its own thread: Some(result), or None if it panicked or timed out.
@@ -122,6 +130,24 @@ fn every_regression_input_loads_or_fails_cleanly() {
 fn error_of(format: &str, name: &str) -> String {
     let path = corpus().join(format).join(name);
     run_case(format, &path).unwrap().unwrap_err()
+}
+
+/// Every size a glTF file can claim is refused with the reason before it is allocated.
+#[test]
+fn oversized_gltf_claims_are_refused_with_the_reason() {
+    let e = error_of("gltf", "accessor-count-4e9-in-36-bytes.err.gltf");
+    assert!(e.contains("attributes.POSITION: accessor 0 reads past the end of buffer 0"), "{e}");
+    let e = error_of("gltf", "unbacked-accessor-1e9.err.gltf");
+    assert!(e.contains("no bufferView and 1000000000 elements"), "{e}");
+    let e = error_of("gltf", "sparse-count-above-the-accessor.err.gltf");
+    assert!(e.contains("sparse.count: 1000000 substitutions in an accessor of 3 elements"), "{e}");
+    let e = error_of("gltf", "png-claiming-65535x65535.err.gltf");
+    assert!(e.contains("images[0]: image of 65535 x 65535 pixels"), "{e}");
+    let e = error_of("gltf", "json-chunk-of-4-gib.err.glb");
+    assert!(e.contains("length 4294967280 runs past the end of the file"), "{e}");
+    let e = error_of("gltf", "node-is-its-own-child.err.gltf");
+    assert!(e.contains("node 0 appears twice"), "{e}");
+    assert!(run_case("gltf", &corpus().join("gltf").join("one-triangle.gltf")).unwrap().is_ok());
 }
 
 /// The specific complaints of the issue get specific messages.
