@@ -1,6 +1,7 @@
 //! Estimator pieces the path tracers share: choosing a light and a point on it for
 //! next-event estimation, the MIS weight of an emitter that a sampled direction reaches, and
-//! what the environment lights and a hit area light send back along a path. The direct
+//! what the environment lights and a hit area light send back along a path, and Russian
+//! roulette. The direct
 //! integrator weights by its sample counts and the Whitted integrator does not weight, so
 //! they keep their own.
 
@@ -89,4 +90,22 @@ pub(crate) fn add_emitted(
         let w = emitter_weight(strategy, prev, || scene.light_pdf(prev.p, li_idx, si.prim, ray.dir, si.p, si.ng));
         *l += throughput * le * w;
     }
+}
+
+/// Russian roulette: false when the path ends; otherwise the throughput is divided by the
+/// survival probability. That is `fixed` where the settings give one, else the throughput's
+/// largest channel times `eta_scale` (which undoes the 1/eta^2 radiance scaling of
+/// refraction, as pbrt and Mitsuba do), capped at 0.95 so that a path trapped between
+/// mirrors still ends. A probability that is not positive ends the path.
+#[inline]
+pub(crate) fn survives_roulette(throughput: &mut Rgb, eta_scale: f32, fixed: Option<f32>, rng: &mut Sampler) -> bool {
+    let q = match fixed {
+        Some(q) => q,
+        None => (throughput.max_component() * eta_scale).min(0.95),
+    };
+    if !(q > 0.0) || rng.next_f32() >= q {
+        return false;
+    }
+    *throughput = *throughput / q;
+    true
 }

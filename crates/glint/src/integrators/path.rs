@@ -9,7 +9,7 @@
 //! reference); `path_batch` traces many paths' rays together. Both run the same steps in the
 //! same order, so a path's radiance is the same bits either way.
 
-use super::estimators::{add_emitted, add_environment, sample_light, PrevEvent};
+use super::estimators::{add_emitted, add_environment, sample_light, survives_roulette, PrevEvent};
 use super::surface::{passes_mask, transmittance};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
@@ -193,15 +193,8 @@ impl PathState {
         self.prev = PrevEvent { pdf: bs.pdf, delta: bs.delta, p: si.p };
         self.ray = spawn_ray(&si, wi_world);
 
-        if self.depth >= s.rr_depth {
-            let q = match s.rr_probability {
-                Some(p) => p,
-                None => (self.throughput.max_component() * self.eta_scale).min(0.95),
-            };
-            if q <= 0.0 || rng.next_f32() >= q {
-                return;
-            }
-            self.throughput = self.throughput / q;
+        if self.depth >= s.rr_depth && !survives_roulette(&mut self.throughput, self.eta_scale, s.rr_probability, rng) {
+            return;
         }
         self.tracing = true;
     }

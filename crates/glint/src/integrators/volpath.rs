@@ -22,7 +22,7 @@
 //! extinction from a density grid) sample distances by delta tracking and estimate shadow
 //! rays' transmittance by ratio tracking, both against the grid's majorant.
 
-use super::estimators::{add_emitted, add_environment, sample_light, PrevEvent};
+use super::estimators::{add_emitted, add_environment, sample_light, survives_roulette, PrevEvent};
 use super::path::MAX_PATH_DEPTH;
 use super::surface::opacity;
 use super::{shading, shadow_ray, spawn_ray, Counters};
@@ -225,15 +225,7 @@ fn add_light_at_surface(
 /// Russian roulette from `rr_depth` scattering events on; false when the path ends.
 #[inline]
 fn roulette(s: &VolpathSettings, depth: u32, throughput: &mut Rgb, eta_scale: f32, rng: &mut Sampler) -> bool {
-    if depth < s.rr_depth {
-        return true;
-    }
-    let q = (throughput.max_component() * eta_scale).min(0.95);
-    if !(q > 0.0) || rng.next_f32() >= q {
-        return false;
-    }
-    *throughput = *throughput / q;
-    true
+    depth < s.rr_depth || survives_roulette(throughput, eta_scale, None, rng)
 }
 
 /// Next-event estimation at a scattering point `p` in medium `m` (index `medium`).

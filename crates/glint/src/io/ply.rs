@@ -179,10 +179,66 @@ pub fn read_ply(path: &Path) -> Result<PlyMesh, String> {
     parse_ply(&data, path)
 }
 
+/// A PLY header: the body's format, its elements in order, where the body starts and the
+/// header's last line number (ASCII body lines count on from it).
+struct Header {
+    format: Format,
+    elements: Vec<Element>,
+    body_start: usize,
+    line_no: usize,
+}
+
 /// Parses a PLY file held in memory; `path` only names it in errors.
 pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
     let p = path.display();
-    // Header: lines up to "end_header".
+    let Header { format, elements, body_start, line_no } = parse_header(data, path)?;
+    let body = &data[body_start..];
+    let tokens = if format == Format::Ascii {
+        let text = std::str::from_utf8(body).map_err(|_| format!("{p}: ASCII body is not text"))?;
+        text.lines().enumerate().flat_map(|(i, l)| l.split_whitespace().map(move |t| (t, line_no + 1 + i))).collect()
+    } else {
+        Vec::new()
+    };
+    let mut r = Reader { data: body, pos: 0, format, tokens, tok: 0 };
+
+    let mut mesh = PlyMesh::default();
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    for el in &elements {
+        // An element of no properties takes no room, whatever its count claims.
+        if el.props.is_empty() {
+            continue;
+        }
+        // Each entry takes at least one value per property: a count that the rest of the
+        // file cannot hold is corrupt, and is refused before it drives any loop or allocation.
+        let min_entry: usize = el.props.iter().map(|pr| r.min_len(pr.list.unwrap_or(pr.ty))).sum();
+        if el.count.saturating_mul(min_entry) > r.remaining() {
+            return Err(format!(
+                "{p}: element '{}' claims {} entries, more than the rest of the file can hold (truncated or corrupt)",
+                el.name, el.count
+            ));
+        }
+        match el.name.as_str() {
+            "vertex" => read_vertices(el, &mut r, path, &mut mesh, &mut normals, &mut uvs)?,
+            "face" => read_faces(el, &mut r, path, &mut mesh)?,
+            _ => skip_element(el, &mut r, path)?,
+        }
+    }
+    if mesh.indices.is_empty() {
+        return Err(format!("{p}: no faces"));
+    }
+    if !normals.is_empty() {
+        mesh.normals = Some(normals);
+    }
+    if !uvs.is_empty() {
+        mesh.uvs = Some(uvs);
+    }
+    Ok(mesh)
+}
+
+/// Reads the header: lines up to "end_header".
+fn parse_header(data: &[u8], path: &Path) -> Result<Header, String> {
+    let p = path.display();
     let mut pos = 0;
     let mut line_no = 0;
     let mut format = None;
@@ -213,31 +269,10 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
                     other => return Err(format!("{p}:{line_no}: unknown PLY format {:?}", other.unwrap_or(""))),
                 })
             }
-            Some("element") => {
-                let (Some(name), Some(count)) = (parts.get(1), parts.get(2).and_then(|c| c.parse::<usize>().ok()))
-                else {
-                    return Err(format!("{p}:{line_no}: malformed element line (the count must be a whole number)"));
-                };
-                if count > MAX_ELEMENT_COUNT {
-                    return Err(format!(
-                        "{p}:{line_no}: element '{name}' has {count} entries, more than the {MAX_ELEMENT_COUNT} allowed"
-                    ));
-                }
-                elements.push(Element { name: name.to_string(), count, props: Vec::new() });
-            }
+            Some("element") => elements.push(element_line(&parts, path, line_no)?),
             Some("property") => {
                 let el = elements.last_mut().ok_or_else(|| format!("{p}:{line_no}: property before any element"))?;
-                let bad = || format!("{p}:{line_no}: malformed property line");
-                if parts.get(1) == Some(&"list") {
-                    let ct = parts.get(2).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
-                    let ty = parts.get(3).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
-                    let name = parts.get(4).ok_or_else(bad)?;
-                    el.props.push(Property { name: name.to_string(), ty, list: Some(ct) });
-                } else {
-                    let ty = parts.get(1).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
-                    let name = parts.get(2).ok_or_else(bad)?;
-                    el.props.push(Property { name: name.to_string(), ty, list: None });
-                }
+                el.props.push(property_line(&parts, path, line_no)?);
             }
             Some("end_header") => break,
             Some("comment") | Some("obj_info") | None => {}
@@ -245,144 +280,165 @@ pub fn parse_ply(data: &[u8], path: &Path) -> Result<PlyMesh, String> {
         }
     }
     let format = format.ok_or_else(|| format!("{p}: header has no 'format' line"))?;
-    let body = &data[pos..];
-    let tokens = if format == Format::Ascii {
-        let text = std::str::from_utf8(body).map_err(|_| format!("{p}: ASCII body is not text"))?;
-        text.lines().enumerate().flat_map(|(i, l)| l.split_whitespace().map(move |t| (t, line_no + 1 + i))).collect()
-    } else {
-        Vec::new()
-    };
-    let mut r = Reader { data: body, pos: 0, format, tokens, tok: 0 };
+    Ok(Header { format, elements, body_start: pos, line_no })
+}
 
-    let mut mesh = PlyMesh::default();
-    let mut normals = Vec::new();
-    let mut uvs = Vec::new();
-    for el in &elements {
-        // An element of no properties takes no room, whatever its count claims.
-        if el.props.is_empty() {
-            continue;
-        }
-        // Each entry takes at least one value per property: a count that the rest of the
-        // file cannot hold is corrupt, and is refused before it drives any loop or allocation.
-        let min_entry: usize = el.props.iter().map(|pr| r.min_len(pr.list.unwrap_or(pr.ty))).sum();
-        if el.count.saturating_mul(min_entry) > r.remaining() {
-            return Err(format!(
-                "{p}: element '{}' claims {} entries, more than the rest of the file can hold (truncated or corrupt)",
-                el.name, el.count
-            ));
-        }
-        let idx = |n: &[&str]| el.props.iter().position(|pr| n.contains(&pr.name.as_str()));
-        match el.name.as_str() {
-            "vertex" => {
-                let (x, y, z) = (idx(&["x"]), idx(&["y"]), idx(&["z"]));
-                let (Some(x), Some(y), Some(z)) = (x, y, z) else {
-                    return Err(format!("{p}: vertex element lacks x, y or z"));
-                };
-                let (nx, ny, nz) = (idx(&["nx"]), idx(&["ny"]), idx(&["nz"]));
-                let (u, v) = (idx(&["u", "s", "texture_u", "texture_s"]), idx(&["v", "t", "texture_v", "texture_t"]));
-                let mut reserved = vec!["x", "y", "z", "nx", "ny", "nz", LIST];
-                for k in [u, v].into_iter().flatten() {
-                    reserved.push(el.props[k].name.as_str());
-                }
-                let mut attrs = AttributeReader::new(
-                    attribute_layout(&prop_names(el), &reserved, "vertex_"),
-                    AttributeScope::Vertex,
-                );
-                let mut attr_vals = vec![0.0f32; el.props.len()];
-                let mut vals = vec![0.0f64; el.props.len()];
-                for _ in 0..el.count {
-                    for (k, pr) in el.props.iter().enumerate() {
-                        if let Some(ct) = pr.list {
-                            let n = r.read_count(ct, pr.ty, path)?;
-                            for _ in 0..n {
-                                r.read(pr.ty, path)?;
-                            }
-                        } else {
-                            vals[k] = r.read(pr.ty, path)?;
-                            attr_vals[k] = vals[k] as f32;
-                        }
-                    }
-                    attrs.push(&attr_vals, 1);
-                    mesh.positions.push(Vec3 { x: vals[x] as f32, y: vals[y] as f32, z: vals[z] as f32 });
-                    if let (Some(a), Some(b), Some(c)) = (nx, ny, nz) {
-                        normals.push(Vec3 { x: vals[a] as f32, y: vals[b] as f32, z: vals[c] as f32 });
-                    }
-                    if let (Some(a), Some(b)) = (u, v) {
-                        // Images are looked up top-down; PLY's v points up.
-                        uvs.push([vals[a] as f32, 1.0 - vals[b] as f32]);
-                    }
-                }
-                mesh.attributes.extend(attrs.finish());
-            }
-            "face" => {
-                let list = el
-                    .props
-                    .iter()
-                    .position(|pr| pr.list.is_some() && (pr.name == "vertex_indices" || pr.name == "vertex_index"))
-                    .ok_or_else(|| format!("{p}: face element has no vertex_indices list"))?;
-                let mut attrs =
-                    AttributeReader::new(attribute_layout(&prop_names(el), &[LIST], "face_"), AttributeScope::Face);
-                let mut attr_vals = vec![0.0f32; el.props.len()];
-                for f in 0..el.count {
-                    let triangles_before = mesh.indices.len();
-                    for (k, pr) in el.props.iter().enumerate() {
-                        if let Some(ct) = pr.list {
-                            let n = r.read_count(ct, pr.ty, path)?;
-                            let mut ids = Vec::with_capacity(n);
-                            for _ in 0..n {
-                                ids.push(r.read(pr.ty, path)?);
-                            }
-                            if k == list {
-                                if n < 3 {
-                                    return Err(format!("{p}: face {f} has {n} vertices (needs 3 or more)"));
-                                }
-                                let nv = mesh.positions.len();
-                                for &i in &ids {
-                                    // Also rejects NaN and fractional indices.
-                                    if !(i >= 0.0 && i.fract() == 0.0 && i < nv as f64) {
-                                        return Err(format!(
-                                            "{p}: face {f} uses vertex {i} but there are {nv} vertices"
-                                        ));
-                                    }
-                                }
-                                for t in 1..n - 1 {
-                                    mesh.indices.push([ids[0] as u32, ids[t] as u32, ids[t + 1] as u32]);
-                                }
-                            }
-                        } else {
-                            attr_vals[k] = r.read(pr.ty, path)? as f32;
-                        }
-                    }
-                    attrs.push(&attr_vals, mesh.indices.len() - triangles_before);
-                }
-                mesh.attributes.extend(attrs.finish());
-            }
-            _ => {
-                for _ in 0..el.count {
-                    for pr in &el.props {
-                        if let Some(ct) = pr.list {
-                            let n = r.read_count(ct, pr.ty, path)?;
-                            for _ in 0..n {
-                                r.read(pr.ty, path)?;
-                            }
-                        } else {
-                            r.read(pr.ty, path)?;
-                        }
-                    }
-                }
+/// `element NAME COUNT`, the count bounded by [`MAX_ELEMENT_COUNT`].
+fn element_line(parts: &[&str], path: &Path, line_no: usize) -> Result<Element, String> {
+    let p = path.display();
+    let (Some(name), Some(count)) = (parts.get(1), parts.get(2).and_then(|c| c.parse::<usize>().ok())) else {
+        return Err(format!("{p}:{line_no}: malformed element line (the count must be a whole number)"));
+    };
+    if count > MAX_ELEMENT_COUNT {
+        return Err(format!(
+            "{p}:{line_no}: element '{name}' has {count} entries, more than the {MAX_ELEMENT_COUNT} allowed"
+        ));
+    }
+    Ok(Element { name: name.to_string(), count, props: Vec::new() })
+}
+
+/// `property TYPE NAME` or `property list COUNT_TYPE TYPE NAME`.
+fn property_line(parts: &[&str], path: &Path, line_no: usize) -> Result<Property, String> {
+    let bad = || format!("{}:{line_no}: malformed property line", path.display());
+    if parts.get(1) == Some(&"list") {
+        let ct = parts.get(2).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
+        let ty = parts.get(3).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
+        let name = parts.get(4).ok_or_else(bad)?;
+        Ok(Property { name: name.to_string(), ty, list: Some(ct) })
+    } else {
+        let ty = parts.get(1).and_then(|s| Scalar::parse(s)).ok_or_else(bad)?;
+        let name = parts.get(2).ok_or_else(bad)?;
+        Ok(Property { name: name.to_string(), ty, list: None })
+    }
+}
+
+/// Skips one list property's values.
+fn skip_list(r: &mut Reader, ct: Scalar, ty: Scalar, path: &Path) -> Result<(), String> {
+    let n = r.read_count(ct, ty, path)?;
+    for _ in 0..n {
+        r.read(ty, path)?;
+    }
+    Ok(())
+}
+
+/// The vertex element: positions, normals and texture coordinates where declared, the other
+/// scalar properties as `vertex_` attributes.
+fn read_vertices(
+    el: &Element,
+    r: &mut Reader,
+    path: &Path,
+    mesh: &mut PlyMesh,
+    normals: &mut Vec<Vec3>,
+    uvs: &mut Vec<[f32; 2]>,
+) -> Result<(), String> {
+    let idx = |n: &[&str]| el.props.iter().position(|pr| n.contains(&pr.name.as_str()));
+    let (x, y, z) = (idx(&["x"]), idx(&["y"]), idx(&["z"]));
+    let (Some(x), Some(y), Some(z)) = (x, y, z) else {
+        return Err(format!("{}: vertex element lacks x, y or z", path.display()));
+    };
+    let (nx, ny, nz) = (idx(&["nx"]), idx(&["ny"]), idx(&["nz"]));
+    let (u, v) = (idx(&["u", "s", "texture_u", "texture_s"]), idx(&["v", "t", "texture_v", "texture_t"]));
+    let mut reserved = vec!["x", "y", "z", "nx", "ny", "nz", LIST];
+    for k in [u, v].into_iter().flatten() {
+        reserved.push(el.props[k].name.as_str());
+    }
+    let mut attrs =
+        AttributeReader::new(attribute_layout(&prop_names(el), &reserved, "vertex_"), AttributeScope::Vertex);
+    let mut attr_vals = vec![0.0f32; el.props.len()];
+    let mut vals = vec![0.0f64; el.props.len()];
+    for _ in 0..el.count {
+        for (k, pr) in el.props.iter().enumerate() {
+            if let Some(ct) = pr.list {
+                skip_list(r, ct, pr.ty, path)?;
+            } else {
+                vals[k] = r.read(pr.ty, path)?;
+                attr_vals[k] = vals[k] as f32;
             }
         }
+        attrs.push(&attr_vals, 1);
+        mesh.positions.push(Vec3 { x: vals[x] as f32, y: vals[y] as f32, z: vals[z] as f32 });
+        if let (Some(a), Some(b), Some(c)) = (nx, ny, nz) {
+            normals.push(Vec3 { x: vals[a] as f32, y: vals[b] as f32, z: vals[c] as f32 });
+        }
+        if let (Some(a), Some(b)) = (u, v) {
+            // Images are looked up top-down; PLY's v points up.
+            uvs.push([vals[a] as f32, 1.0 - vals[b] as f32]);
+        }
     }
-    if mesh.indices.is_empty() {
-        return Err(format!("{p}: no faces"));
+    mesh.attributes.extend(attrs.finish());
+    Ok(())
+}
+
+/// The face element: `vertex_indices` fan-triangulated, the other scalar properties as
+/// `face_` attributes (a polygon's value repeated for each of its triangles).
+fn read_faces(el: &Element, r: &mut Reader, path: &Path, mesh: &mut PlyMesh) -> Result<(), String> {
+    let p = path.display();
+    let list = el
+        .props
+        .iter()
+        .position(|pr| pr.list.is_some() && (pr.name == "vertex_indices" || pr.name == "vertex_index"))
+        .ok_or_else(|| format!("{p}: face element has no vertex_indices list"))?;
+    let mut attrs = AttributeReader::new(attribute_layout(&prop_names(el), &[LIST], "face_"), AttributeScope::Face);
+    let mut attr_vals = vec![0.0f32; el.props.len()];
+    for f in 0..el.count {
+        let triangles_before = mesh.indices.len();
+        for (k, pr) in el.props.iter().enumerate() {
+            match pr.list {
+                Some(ct) if k == list => read_polygon(r, ct, pr.ty, path, f, mesh)?,
+                Some(ct) => skip_list(r, ct, pr.ty, path)?,
+                None => attr_vals[k] = r.read(pr.ty, path)? as f32,
+            }
+        }
+        attrs.push(&attr_vals, mesh.indices.len() - triangles_before);
     }
-    if !normals.is_empty() {
-        mesh.normals = Some(normals);
+    mesh.attributes.extend(attrs.finish());
+    Ok(())
+}
+
+/// One face's vertex list, checked against the vertices read so far and fan-triangulated.
+fn read_polygon(
+    r: &mut Reader,
+    ct: Scalar,
+    ty: Scalar,
+    path: &Path,
+    f: usize,
+    mesh: &mut PlyMesh,
+) -> Result<(), String> {
+    let p = path.display();
+    let n = r.read_count(ct, ty, path)?;
+    let mut ids = Vec::with_capacity(n);
+    for _ in 0..n {
+        ids.push(r.read(ty, path)?);
     }
-    if !uvs.is_empty() {
-        mesh.uvs = Some(uvs);
+    if n < 3 {
+        return Err(format!("{p}: face {f} has {n} vertices (needs 3 or more)"));
     }
-    Ok(mesh)
+    let nv = mesh.positions.len();
+    for &i in &ids {
+        // Also rejects NaN and fractional indices.
+        if !(i >= 0.0 && i.fract() == 0.0 && i < nv as f64) {
+            return Err(format!("{p}: face {f} uses vertex {i} but there are {nv} vertices"));
+        }
+    }
+    for t in 1..n - 1 {
+        mesh.indices.push([ids[0] as u32, ids[t] as u32, ids[t + 1] as u32]);
+    }
+    Ok(())
+}
+
+/// An element glint does not use: its values are read past.
+fn skip_element(el: &Element, r: &mut Reader, path: &Path) -> Result<(), String> {
+    for _ in 0..el.count {
+        for pr in &el.props {
+            match pr.list {
+                Some(ct) => skip_list(r, ct, pr.ty, path)?,
+                None => {
+                    r.read(pr.ty, path)?;
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
