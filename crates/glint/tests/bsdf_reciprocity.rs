@@ -3,11 +3,11 @@
 //! (Veach 1997, §5.2). For reflection both sides match and f is symmetric; for refraction the
 //! (η(wo)/η(wi))² radiance scaling is what makes the two sides agree.
 
-use glint::bsdf::{
-    fresnel_dielectric, BlendBsdf, BlendPart, Bsdf, GltfPbr, Microfacet, MicrofacetKind, PPlasticParams, Phong,
-    PlasticParams, Principled, PrincipledInputs, PrincipledRates,
+use glint::bsdf::{fresnel_dielectric, Microfacet, MicrofacetKind};
+use glint::materials::{
+    BlendBsdf, BlendPart, Bsdf, Diffuse, GltfPbr, HairBsdf, PPlasticParams, Phong, PlasticParams, Principled,
+    PrincipledInputs, PrincipledRates, RoughConductor, RoughDielectric,
 };
-use glint::bsdf::{Diffuse, HairBsdf, RoughConductor, RoughDielectric};
 use glint::math::{rgb, vec3, Rgb, Vec3};
 use glint::sampling::{warp, Rng};
 

@@ -6,11 +6,11 @@ mod common;
 
 use common::bsdf_check::{chi2_of, dir, draw_samples, integrate, BsdfCase, Integrals, Samples};
 use common::stats::{sidak, z_critical, FALSE_ALARM};
-use glint::bsdf::{
-    normal_map_frame, BlendBsdf, BlendPart, Bsdf, GltfPbr, HairBsdf, Microfacet, MicrofacetKind, PPlasticParams, Phong,
-    PlasticParams, Principled, PrincipledInputs, PrincipledRates, ShadedBsdf,
+use glint::bsdf::{Microfacet, MicrofacetKind};
+use glint::materials::{
+    normal_map_frame, BlendBsdf, BlendPart, Bsdf, Conductor, Diffuse, GltfPbr, HairBsdf, PPlasticParams, Phong,
+    PlasticParams, Principled, PrincipledInputs, PrincipledRates, RoughConductor, RoughDielectric, ShadedBsdf,
 };
-use glint::bsdf::{Conductor, Diffuse, RoughConductor, RoughDielectric};
 use glint::math::vec3;
 use glint::math::{rgb, Rgb};
 use rayon::prelude::*;

@@ -9,7 +9,7 @@ use glint::assemble::WorldBuilder;
 use glint::camera::{Camera, FovAxis};
 use glint::geometry::TriangleMesh;
 use glint::lights::LightSelection;
-use glint::materials::{Material, MaterialKind, Texture};
+use glint::materials::{DiffuseMaterial, Material, MaterialKind, Texture};
 use glint::math::{vec3, Ray, Rgb, Transform, Vec3};
 use glint::world::World;
 use proptest::prelude::*;
@@ -116,7 +116,7 @@ proptest! {
     ) {
         let mesh = Arc::new(mesh_from(&points, &heights, BvhSplit::Sah));
         let mut b = WorldBuilder::new(BvhSplit::Sah);
-        let m = b.add_material(Material::new("m", MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) }, true));
+        let m = b.add_material(Material::new("m", MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::splat(0.5)) }), true));
         for (i, &(x, y, z, angle, s)) in placements.iter().enumerate() {
             let t = Transform::translate(vec3(x, y, z))
                 .then_after(&Transform::rotate(vec3(0.3, 1.0, 0.2), angle))

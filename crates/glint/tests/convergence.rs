@@ -20,7 +20,7 @@ use glint::assemble::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::LightSelection;
-use glint::materials::{Material, MaterialKind, Texture};
+use glint::materials::{DiffuseMaterial, Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::render::RenderOutput;
 use glint::world::World;
@@ -106,7 +106,7 @@ fn furnace_error_falls_as_inverse_sqrt_spp() {
     let mut b = WorldBuilder::new(BvhSplit::Sah);
     let wall = b.add_material(Material::new(
         "wall",
-        MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },
+        MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::splat(0.5)) }),
         false,
     ));
     b.add_sphere(Vec3::ZERO, 2.5, &Transform::IDENTITY, wall, emission(1.0), true).unwrap();

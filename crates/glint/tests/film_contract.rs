@@ -11,7 +11,7 @@ use glint::accel::BvhSplit;
 use glint::assemble::WorldBuilder;
 use glint::integrators::{Integrator, Strategy, WhittedSettings};
 use glint::lights::LightSelection;
-use glint::materials::{Material, MaterialKind, Texture};
+use glint::materials::{DiffuseMaterial, Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::render::{
     read_film, render, render_passes, write_film, Adaptive, Aov, Film, FilmMeta, PassRequest, Rect, RenderSettings,
@@ -232,7 +232,11 @@ fn checker() -> Texture {
 
 fn aov_scene() -> World {
     let mut b = WorldBuilder::new(BvhSplit::Sah);
-    let plane = b.add_material(Material::new("checker", MaterialKind::Diffuse { reflectance: checker() }, true));
+    let plane = b.add_material(Material::new(
+        "checker",
+        MaterialKind::Diffuse(DiffuseMaterial { reflectance: checker() }),
+        true,
+    ));
     let ball = diffuse(&mut b, "ball", Rgb::splat(0.5));
     let h = PLANE_HALF;
     add_quad(&mut b, [vec3(-h, -h, 0.0), vec3(h, -h, 0.0), vec3(h, h, 0.0), vec3(-h, h, 0.0)], plane, None);

@@ -13,7 +13,8 @@
 mod common;
 
 use common::stats::{z_critical, FALSE_ALARM};
-use glint::bsdf::{sheen_albedo_quadrature, GltfPbr, Scatter, SHEEN_ALBEDO_TOLERANCE, SHEEN_MIN_ROUGHNESS};
+use glint::bsdf::Scatter;
+use glint::materials::{sheen_albedo_quadrature, GltfPbr, SHEEN_ALBEDO_TOLERANCE, SHEEN_MIN_ROUGHNESS};
 use glint::math::{rgb, Rgb, Vec3};
 use glint::sampling::{warp, Rng};
 use std::f64::consts::PI;

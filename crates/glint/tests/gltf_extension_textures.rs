@@ -8,8 +8,8 @@
 mod common;
 
 use common::scratch::ScratchDir;
-use glint::bsdf::Bsdf;
 use glint::formats::ReadOptions;
+use glint::materials::Bsdf;
 use glint::session::Session;
 use serde_json::json;
 

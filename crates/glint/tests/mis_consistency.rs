@@ -12,7 +12,7 @@ use glint::assemble::WorldBuilder;
 use glint::bsdf::{Microfacet, MicrofacetKind};
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::{AreaEmission, LightSelection};
-use glint::materials::{Material, MaterialKind};
+use glint::materials::{Material, MaterialKind, RoughConductorMaterial};
 use glint::math::{rgb, vec3, Rgb, Transform, Vec3};
 use glint::world::World;
 
@@ -26,7 +26,11 @@ const STRATEGIES: [Strategy; 3] = [Strategy::Mis, Strategy::Light, Strategy::Bsd
 fn glossy(b: &mut WorldBuilder, name: &str, dist: Microfacet) -> u32 {
     let (eta, k) = (rgb(0.2, 0.92, 1.1), rgb(3.9, 2.45, 2.14)); // copper
     let dist = dist.into();
-    b.add_material(Material::new(name, MaterialKind::RoughConductor { dist, eta, k, specular: Rgb::WHITE }, true))
+    b.add_material(Material::new(
+        name,
+        MaterialKind::RoughConductor(RoughConductorMaterial { dist, eta, k, specular: Rgb::WHITE }),
+        true,
+    ))
 }
 
 fn scene() -> World {

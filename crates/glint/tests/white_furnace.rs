@@ -16,7 +16,7 @@ use glint::assemble::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::LightSelection;
-use glint::materials::{Material, MaterialKind, Texture};
+use glint::materials::{DiffuseMaterial, Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::world::World;
 use std::sync::Arc;
@@ -89,7 +89,7 @@ fn emitting_enclosure() -> World {
     // One-sided, so that a wrongly oriented surface would show up black.
     let wall = b.add_material(Material::new(
         "wall",
-        MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(a)) },
+        MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::splat(a)) }),
         false,
     ));
     // A sphere facing inwards around a box: two lights of different kinds, so light

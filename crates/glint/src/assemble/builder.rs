@@ -8,7 +8,10 @@ use crate::geometry::{CurveBasis, Curves, Cylinder, SdfGrid, SdfGridData, SdfNor
 use crate::io::{obj, ply, serialized};
 use crate::lights::LightSelection;
 use crate::lights::{scene_radius, AreaEmission, EnvMap, Light, MeshEmitter};
-use crate::materials::{Bitmap, Material, MaterialKind, Texture};
+use crate::materials::Black;
+use crate::materials::{
+    Bitmap, ConductorMaterial, DielectricMaterial, DiffuseMaterial, Material, MaterialKind, PhongMaterial, Texture,
+};
 use crate::math::{vec3, Aabb, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
 use crate::world::{Instance, ShapeRef, World};
@@ -145,13 +148,17 @@ fn gltf_primitive(
 /// Material for an MTL entry (used when an OBJ shape names no material).
 fn material_from_mtl(m: &obj::MtlMaterial) -> Material {
     let kind = if m.illum == 7 || m.dissolve < 1.0 {
-        MaterialKind::Dielectric { eta: m.ni.max(1.0001), reflect: Rgb::WHITE, transmit: Rgb::WHITE }
+        MaterialKind::Dielectric(DielectricMaterial {
+            eta: m.ni.max(1.0001),
+            reflect: Rgb::WHITE,
+            transmit: Rgb::WHITE,
+        })
     } else if m.illum == 5 {
-        MaterialKind::Conductor { eta: Rgb::BLACK, k: Rgb::WHITE, specular: m.ks }
+        MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: m.ks })
     } else if m.ks.max_component() > 0.0 && m.ns > 0.0 {
-        MaterialKind::Phong { kd: Texture::Constant(m.kd), ks: m.ks, exponent: m.ns }
+        MaterialKind::Phong(PhongMaterial { kd: Texture::Constant(m.kd), ks: m.ks, exponent: m.ns })
     } else {
-        MaterialKind::Diffuse { reflectance: Texture::Constant(m.kd) }
+        MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(m.kd) })
     };
     Material::new(format!("mtl:{}", m.name), kind, true)
 }
@@ -222,7 +229,7 @@ impl WorldBuilder {
         if let Some(id) = self.material_id("__black") {
             return id;
         }
-        self.add_material(Material::new("__black", MaterialKind::Black, false))
+        self.add_material(Material::new("__black", MaterialKind::Black(Black), false))
     }
 
     /// A default diffuse material (Mitsuba's: reflectance 0.5), for shapes without one.
@@ -232,7 +239,7 @@ impl WorldBuilder {
         }
         self.add_material(Material::new(
             "__default",
-            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },
+            MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::splat(0.5)) }),
             false,
         ))
     }

@@ -8,7 +8,7 @@
 //! [`BuildCounters`] count what was built, so tests and users can see it.
 
 use super::builder::{bake, environment_lights, read_mesh_file};
-use super::{add_light, camera, material_id, material_kind, mesh_loc, transform_of, validate, TextureCache};
+use super::{add_light, camera, material_id, mesh_loc, transform_of, validate};
 use super::{BuildOptions, LoadedGroup, WorldBuilder};
 use crate::accel::BvhSplit;
 use crate::describe::{
@@ -18,7 +18,7 @@ use crate::describe::{
 use crate::error::{Error, SourceLoc};
 use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, CurveBasis, SdfNormals, TriangleMesh};
 use crate::lights::{AreaEmission, Light};
-use crate::materials::Material;
+use crate::materials::{Material, MaterialKind, TextureCache};
 use crate::math::Transform;
 use crate::world::World;
 use rayon::prelude::*;
@@ -307,10 +307,9 @@ fn add_shape(
     Ok(())
 }
 
-/// What a shape emits, its texture made (or found in the cache).
 /// A described material, built: its kind with textures loaded, its sides.
 fn material(m: &MaterialDesc, textures: &mut TextureCache) -> Result<Material, Error> {
-    let kind = material_kind(&m.model, textures).map_err(|e| e.or_at(&m.loc))?;
+    let kind = MaterialKind::build(&m.model, textures).map_err(|e| e.or_at(&m.loc))?;
     let mut out = Material::new(m.name.clone(), kind, m.two_sided);
     if let MaterialModel::Gltf(g) = &m.model {
         out.cull_back_faces = g.culls_back_faces();
@@ -318,6 +317,7 @@ fn material(m: &MaterialDesc, textures: &mut TextureCache) -> Result<Material, E
     Ok(out)
 }
 
+/// What a shape emits, its texture made (or found in the cache).
 fn area_emission(e: Option<&Emission>, textures: &mut TextureCache) -> Result<Option<AreaEmission>, Error> {
     e.map(|e| Ok(AreaEmission { radiance: textures.texture(&e.radiance)?, two_sided: e.two_sided })).transpose()
 }

@@ -133,7 +133,7 @@ mod tests {
     use crate::camera::{Camera, FovAxis};
     use crate::geometry::quad_mesh;
     use crate::lights::LightSelection;
-    use crate::materials::{Material, MaterialKind, Texture};
+    use crate::materials::{DiffuseMaterial, Material, MaterialKind, Texture};
     use crate::math::{vec3, Transform};
     use std::sync::Arc;
 
@@ -143,7 +143,7 @@ mod tests {
         let mut b = WorldBuilder::new(BvhSplit::Sah);
         let m = b.add_material(Material::new(
             "grey",
-            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },
+            MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::splat(0.5)) }),
             true,
         ));
         for k in 0..n {

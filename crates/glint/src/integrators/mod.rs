@@ -19,7 +19,7 @@ pub use crate::describe::{DirectSettings, PathSettings, Strategy, VolpathSetting
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 pub use path_batch::CameraSample;
 
-use crate::bsdf::ShadedBsdf;
+use crate::materials::ShadedBsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::sampling::Sampler;
 use crate::world::{BatchTraversal, Hit, SurfaceInteraction, World};

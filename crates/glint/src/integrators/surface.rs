@@ -2,7 +2,7 @@
 //! frame, masks let light through. Shared by the integrators.
 
 use super::Counters;
-use crate::bsdf::{flip_invalid, normal_map_frame, ShadedBsdf};
+use crate::materials::{flip_invalid, normal_map_frame, ShadedBsdf};
 use crate::materials::{Perturbation, TexturePoint, TANGENT_ATTRIBUTE, TANGENT_SIGN_ATTRIBUTE};
 use crate::math::{offset_origin, Frame, Ray, Vec3};
 use crate::sampling::Sampler;

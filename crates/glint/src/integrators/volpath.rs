@@ -26,8 +26,9 @@ use super::estimators::{add_emitted, add_environment, sample_light, survives_rou
 use super::path::MAX_PATH_DEPTH;
 use super::surface::opacity;
 use super::{shading, shadow_ray, spawn_ray, Counters};
-use crate::bsdf::{Bsdf, BsdfSample, ShadedBsdf};
+use crate::bsdf::BsdfSample;
 use crate::describe::{Strategy, VolpathSettings};
+use crate::materials::{Bsdf, ShadedBsdf};
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::media::{sample_distance, Medium};
 use crate::sampling::{power_heuristic, Sampler};

@@ -7,8 +7,9 @@
 
 use super::surface::{passes_mask, transmittance};
 use super::{shading, shadow_ray, spawn_ray, Counters};
-use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, Bsdf, Dielectric};
+use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local};
 use crate::describe::WhittedSettings;
+use crate::materials::{Bsdf, Dielectric};
 use crate::math::{Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::world::{SurfaceInteraction, World};
@@ -200,7 +201,9 @@ mod tests {
     use crate::geometry::quad_mesh;
     use crate::lights::AreaEmission;
     use crate::lights::LightSelection;
-    use crate::materials::{Material, MaterialKind, Texture};
+    use crate::materials::{
+        ConductorMaterial, DielectricMaterial, DiffuseMaterial, MaskMaterial, Material, MaterialKind, Texture,
+    };
     use crate::math::{vec3, Transform, Vec3};
     use crate::sampling::SamplerKind;
     use std::sync::Arc;
@@ -267,17 +270,17 @@ mod tests {
         let mut b = WorldBuilder::new(BvhSplit::Sah);
         let white = b.add_material(Material::new(
             "white",
-            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.7)) },
+            MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::splat(0.7)) }),
             true,
         ));
         let mirror = b.add_material(Material::new(
             "mirror",
-            MaterialKind::Conductor { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::splat(0.9) },
+            MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::splat(0.9) }),
             true,
         ));
         let glass = b.add_material(Material::new(
             "glass",
-            MaterialKind::Dielectric { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE },
+            MaterialKind::Dielectric(DielectricMaterial { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE }),
             false,
         ));
         let quad = |b: &mut WorldBuilder, p: [Vec3; 4], m: u32, e: Option<AreaEmission>| {
@@ -340,7 +343,7 @@ mod tests {
         let mut b = WorldBuilder::new(BvhSplit::Sah);
         let floor = b.add_material(Material::new(
             "floor",
-            MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::splat(0.5)) },
+            MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::splat(0.5)) }),
             true,
         ));
         // Counter-clockwise from above (normal +z), the light's the other way round.
@@ -356,10 +359,13 @@ mod tests {
         let light = b.black_material();
         quad(&mut b, 0.3, light_z, light, Some(AreaEmission::constant(Rgb::splat(20.0))));
         if let Some(z) = sheet_z {
-            let black = MaterialKind::Diffuse { reflectance: Texture::Constant(Rgb::BLACK) };
+            let black = MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(Rgb::BLACK) });
             let sheet = b.add_material(Material::new(
                 "sheet",
-                MaterialKind::Mask { opacity: Texture::Constant(Rgb::splat(0.5)), nested: Box::new(black) },
+                MaterialKind::Mask(MaskMaterial {
+                    opacity: Texture::Constant(Rgb::splat(0.5)),
+                    nested: Box::new(black),
+                }),
                 true,
             ));
             quad(&mut b, 20.0, z, sheet, None);
@@ -425,7 +431,7 @@ mod tests {
         let mut b = WorldBuilder::new(BvhSplit::Sah);
         let mirror = b.add_material(Material::new(
             "mirror",
-            MaterialKind::Conductor { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::WHITE },
+            MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::WHITE }),
             true,
         ));
         for z in [-1.0f32, 1.0] {

@@ -1,9 +1,158 @@
-//! Blends of two materials (Mitsuba's `blendbsdf`): what a hit evaluates into a
-//! [`BlendBsdf`].
+//! `blendbsdf`: (1 - `weight`) times the first material plus `weight` times the second,
+//! the weight a texture; what a hit evaluates into a [`BlendBsdf`].
+//!
+//! # The BSDF
+//! Mitsuba's `blendbsdf`: (1 - w) · first + w · second, with `w` in [0, 1].
+//!
+//! `eval` and `pdf` are the weighted mixtures. `sample` picks a part with probability
+//! 1 - w or w, samples it, and returns the whole mixture's value over the whole mixture's
+//! pdf at that direction, as Mitsuba 3.9.1 does. For a delta lobe that mixture adds the
+//! lobe's discrete probability (1 by convention) to the other part's density there, so a
+//! delta lobe blended with a glossy one at 0 < w < 1 is weighted less than its share:
+//! Mitsuba's behaviour, kept so that the two renderers agree (docs/mitsuba-support.md).
+//!
+//! Each part may be two-sided on its own (Mitsuba's `twosided` nested inside the blend):
+//! seen from below, such a part is evaluated with both directions mirrored to its front.
+//! The parts live behind a `Box` (a blend is built per hit, the one material kind that
+//! allocates); every other BSDF stays inline.
 
-use super::{MaterialKind, ScalarTexture};
-use crate::bsdf::{BlendBsdf, BlendPart, Bsdf};
-use crate::math::Rgb;
+use super::{Bsdf, MaterialKind, ScalarTexture, Shade, TextureCache, TexturePoint};
+use crate::bsdf::{BsdfSample, Scatter};
+use crate::describe::{BlendDesc, BlendPartDesc};
+use crate::error::Error;
+use crate::math::{Rgb, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct BlendPart {
+    pub bsdf: Bsdf,
+    /// Mitsuba's `twosided` around this part alone.
+    pub two_sided: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct BlendBsdf {
+    /// Weight of the second part, in [0, 1].
+    pub weight: f32,
+    pub parts: Box<[BlendPart; 2]>,
+}
+
+fn mirror(v: Vec3) -> Vec3 {
+    Vec3 { x: v.x, y: v.y, z: -v.z }
+}
+
+impl BlendPart {
+    /// Whether `wo` must be mirrored to this part's front.
+    #[inline]
+    fn flips(&self, wo: Vec3) -> bool {
+        self.two_sided && wo.z < 0.0
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if self.flips(wo) {
+            self.bsdf.eval(mirror(wo), mirror(wi))
+        } else {
+            self.bsdf.eval(wo, wi)
+        }
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.flips(wo) {
+            self.bsdf.pdf(mirror(wo), mirror(wi))
+        } else {
+            self.bsdf.pdf(wo, wi)
+        }
+    }
+
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        if self.flips(wo) {
+            let mut s = self.bsdf.sample(mirror(wo), u_lobe, u)?;
+            s.wi = mirror(s.wi);
+            Some(s)
+        } else {
+            self.bsdf.sample(wo, u_lobe, u)
+        }
+    }
+}
+
+impl BlendBsdf {
+    pub fn new(weight: f32, first: BlendPart, second: BlendPart) -> BlendBsdf {
+        // Mitsuba clips the weight; NaN (a texture cannot give one) would pick neither.
+        let weight = if weight.is_nan() { 0.5 } else { weight.clamp(0.0, 1.0) };
+        BlendBsdf { weight, parts: Box::new([first, second]) }
+    }
+
+    /// (1 - w, w): the weights of the two parts.
+    #[inline]
+    fn weights(&self) -> [f32; 2] {
+        [1.0 - self.weight, self.weight]
+    }
+}
+
+impl Scatter for BlendBsdf {
+    fn is_delta(&self) -> bool {
+        self.parts.iter().all(|p| p.bsdf.is_delta())
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        self.parts.iter().any(|p| p.bsdf.has_delta_lobe())
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let [a, b] = self.weights();
+        let mut v = Rgb::BLACK;
+        if a > 0.0 {
+            v += self.parts[0].eval(wo, wi) * a;
+        }
+        if b > 0.0 {
+            v += self.parts[1].eval(wo, wi) * b;
+        }
+        v
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let [a, b] = self.weights();
+        let mut p = 0.0;
+        if a > 0.0 {
+            p += self.parts[0].pdf(wo, wi) * a;
+        }
+        if b > 0.0 {
+            p += self.parts[1].pdf(wo, wi) * b;
+        }
+        p
+    }
+
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        let w = self.weight;
+        // Mitsuba: the first part when u_lobe > w, with u_lobe rescaled to [0, 1).
+        let (chosen, other, u_lobe) = if w <= 0.0 || (w < 1.0 && u_lobe > w) {
+            (0, 1, ((u_lobe - w) / (1.0 - w)).min(1.0 - f32::EPSILON / 2.0))
+        } else {
+            (1, 0, (u_lobe / w).min(1.0 - f32::EPSILON / 2.0))
+        };
+        let weights = self.weights();
+        let (wc, wx) = (weights[chosen], weights[other]);
+        let mut s = self.parts[chosen].sample(wo, u_lobe, u)?;
+        let (value_other, pdf_other) = if wx > 0.0 {
+            (self.parts[other].eval(wo, s.wi), self.parts[other].pdf(wo, s.wi))
+        } else {
+            (Rgb::BLACK, 0.0)
+        };
+        let pdf = wc * s.pdf + wx * pdf_other;
+        if !(pdf > 0.0) {
+            return None;
+        }
+        // The chosen part's value is its weight times its pdf (for a delta lobe, the
+        // lobe's own weight: its pdf is the lobe's probability).
+        s.weight = (s.weight * (wc * s.pdf) + value_other * wx) / pdf;
+        s.pdf = pdf;
+        Some(s)
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        let [a, b] = self.weights();
+        self.parts[0].bsdf.diffuse_reflectance() * a + self.parts[1].bsdf.diffuse_reflectance() * b
+    }
+}
 
 /// One part of a blend: a material kind and whether it alone is two-sided.
 #[derive(Clone, Debug)]
@@ -23,6 +172,14 @@ impl BlendMaterial {
         BlendMaterial { weight, parts: Box::new([first, second]) }
     }
 
+    pub(crate) fn build(b: &BlendDesc, textures: &mut TextureCache) -> Result<BlendMaterial, Error> {
+        let mut part = |p: &BlendPartDesc| -> Result<BlendMaterialPart, Error> {
+            Ok(BlendMaterialPart { kind: MaterialKind::build(&p.model, textures)?, two_sided: p.two_sided })
+        };
+        let (first, second) = (part(&b.first)?, part(&b.second)?);
+        Ok(BlendMaterial::new(ScalarTexture::new(textures.texture(&b.weight)?), first, second))
+    }
+
     pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {
         // A transmissive part keeps its frame, as a top-level one does.
         let part = |p: &BlendMaterialPart| BlendPart {
@@ -39,5 +196,24 @@ impl BlendMaterial {
     pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
         let w = self.weight.eval(uv).clamp(0.0, 1.0);
         self.parts[0].kind.albedo(uv) * (1.0 - w) + self.parts[1].kind.albedo(uv) * w
+    }
+}
+
+impl Shade for BlendMaterial {
+    #[inline]
+    fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
+        self.bsdf(p.uv)
+    }
+
+    fn albedo(&self, uv: [f32; 2]) -> Rgb {
+        BlendMaterial::albedo(self, uv)
+    }
+
+    fn is_transmissive(&self) -> bool {
+        BlendMaterial::is_transmissive(self)
+    }
+
+    fn nested(&self) -> Option<&MaterialKind> {
+        None
     }
 }

@@ -1,7 +1,12 @@
-//! The wrappers around a material's BSDF that change the surface rather than how it
-//! scatters: normal and bump maps (a tilted shading frame) and masks (opacity).
+//! The wrappers around a material that change the surface rather than how it scatters:
+//! `normalmap` and `bumpmap` (a tilted shading frame) and `mask` (opacity). Each holds the
+//! material it wraps; its own BSDF is black, the nested one scattering.
 
-use super::{Material, MaterialKind, Texture, TexturePoint};
+use super::{Black, Bsdf};
+use super::{Material, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
+use crate::describe::{MaterialModel, TextureDesc};
+use crate::error::Error;
+use crate::math::Rgb;
 
 /// How a material tilts its shading frame.
 #[derive(Clone, Copy, Debug)]
@@ -10,32 +15,102 @@ pub enum Perturbation<'a> {
     BumpMap { height: &'a Texture, scale: f32 },
 }
 
-impl MaterialKind {
-    /// The material a normal map, bump map or mask wraps; `None` for a material that
-    /// scatters.
-    pub fn nested(&self) -> Option<&MaterialKind> {
-        match self {
-            MaterialKind::NormalMap { nested, .. }
-            | MaterialKind::BumpMap { nested, .. }
-            | MaterialKind::Mask { nested, .. } => Some(nested),
-            MaterialKind::Diffuse { .. }
-            | MaterialKind::Phong { .. }
-            | MaterialKind::Conductor { .. }
-            | MaterialKind::RoughConductor { .. }
-            | MaterialKind::Dielectric { .. }
-            | MaterialKind::RoughDielectric { .. }
-            | MaterialKind::ThinDielectric { .. }
-            | MaterialKind::Plastic { .. }
-            | MaterialKind::Black
-            | MaterialKind::Null
-            | MaterialKind::Principled(_)
-            | MaterialKind::Blend(_)
-            | MaterialKind::PPlastic { .. }
-            | MaterialKind::Hair(_)
-            | MaterialKind::Gltf(_) => None,
-        }
-    }
+/// `nested`, shaded in a frame tilted by a tangent-space normal map (Mitsuba's `normalmap`):
+/// the texture's RGB in [0, 1] is the normal's xyz in [-1, 1].
+#[derive(Clone, Debug)]
+pub struct NormalMapMaterial {
+    pub normals: Texture,
+    pub nested: Box<MaterialKind>,
+}
 
+/// `nested`, shaded in a frame tilted by the gradient of `scale` times a height texture
+/// (Mitsuba's `bumpmap`).
+#[derive(Clone, Debug)]
+pub struct BumpMapMaterial {
+    pub height: Texture,
+    pub scale: f32,
+    pub nested: Box<MaterialKind>,
+}
+
+/// `nested` where a surface point is opaque, which it is with probability `opacity`
+/// (clamped to [0, 1]); light passes straight through otherwise (Mitsuba's `mask`).
+#[derive(Clone, Debug)]
+pub struct MaskMaterial {
+    pub opacity: Texture,
+    pub nested: Box<MaterialKind>,
+}
+
+/// A wrapper's texture and nested material, built.
+fn wrap(
+    t: &TextureDesc,
+    nested: &MaterialModel,
+    textures: &mut TextureCache,
+) -> Result<(Texture, Box<MaterialKind>), Error> {
+    Ok((textures.texture(t)?, Box::new(MaterialKind::build(nested, textures)?)))
+}
+
+impl NormalMapMaterial {
+    pub(crate) fn build(
+        normals: &TextureDesc,
+        nested: &MaterialModel,
+        textures: &mut TextureCache,
+    ) -> Result<Self, Error> {
+        let (normals, nested) = wrap(normals, nested, textures)?;
+        Ok(NormalMapMaterial { normals, nested })
+    }
+}
+
+impl BumpMapMaterial {
+    pub(crate) fn build(
+        height: &TextureDesc,
+        scale: f32,
+        nested: &MaterialModel,
+        textures: &mut TextureCache,
+    ) -> Result<Self, Error> {
+        let (height, nested) = wrap(height, nested, textures)?;
+        Ok(BumpMapMaterial { height, scale, nested })
+    }
+}
+
+impl MaskMaterial {
+    pub(crate) fn build(
+        opacity: &TextureDesc,
+        nested: &MaterialModel,
+        textures: &mut TextureCache,
+    ) -> Result<Self, Error> {
+        let (opacity, nested) = wrap(opacity, nested, textures)?;
+        Ok(MaskMaterial { opacity, nested })
+    }
+}
+
+/// The wrappers answer as black, non-transmissive surfaces: the integrators ask the nested
+/// material ([`MaterialKind::base`]).
+macro_rules! wrapper_shade {
+    ($($ty:ty),+) => {$(
+        impl Shade for $ty {
+            #[inline]
+            fn bsdf_at(&self, _p: &TexturePoint) -> Bsdf {
+                Bsdf::Black(Black)
+            }
+
+            fn albedo(&self, _uv: [f32; 2]) -> Rgb {
+                Rgb::BLACK
+            }
+
+            fn is_transmissive(&self) -> bool {
+                false
+            }
+
+            fn nested(&self) -> Option<&MaterialKind> {
+                Some(&self.nested)
+            }
+        }
+    )+};
+}
+
+wrapper_shade!(NormalMapMaterial, BumpMapMaterial, MaskMaterial);
+
+impl MaterialKind {
     /// The material inside every normal map, bump map and mask: the one that scatters.
     pub fn base(&self) -> &MaterialKind {
         let mut k = self;
@@ -56,10 +131,10 @@ impl Material {
     /// one per material).
     pub fn perturbation(&self) -> Option<Perturbation<'_>> {
         self.kind.wrappers().find_map(|k| {
-            if let MaterialKind::NormalMap { normals, .. } = k {
+            if let MaterialKind::NormalMap(NormalMapMaterial { normals, .. }) = k {
                 return Some(Perturbation::NormalMap { normals });
             }
-            if let MaterialKind::BumpMap { height, scale, .. } = k {
+            if let MaterialKind::BumpMap(BumpMapMaterial { height, scale, .. }) = k {
                 return Some(Perturbation::BumpMap { height, scale: *scale });
             }
             None
@@ -68,7 +143,7 @@ impl Material {
 
     /// True when the material has a mask (its surface may let light through unscattered).
     pub fn is_masked(&self) -> bool {
-        self.kind.wrappers().any(|k| matches!(k, MaterialKind::Mask { .. }))
+        self.kind.wrappers().any(|k| matches!(k, MaterialKind::Mask(_)))
     }
 
     /// True when rays may pass the surface unscattered: it has a mask, or its back faces
@@ -83,7 +158,7 @@ impl Material {
     pub fn opacity(&self, p: &TexturePoint) -> f32 {
         let mut o = 1.0f32;
         for k in self.kind.wrappers() {
-            if let MaterialKind::Mask { opacity, .. } = k {
+            if let MaterialKind::Mask(MaskMaterial { opacity, .. }) = k {
                 let v = opacity.eval_at(p).luminance();
                 o *= if v.is_nan() { 1.0 } else { v.clamp(0.0, 1.0) };
             }

@@ -176,7 +176,7 @@ impl World {
     pub(crate) fn update_material_flags(&mut self) {
         self.has_masks = self.materials.iter().any(Material::may_pass_rays);
         self.has_passage_materials =
-            self.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null | MaterialKind::ThinDielectric { .. }));
+            self.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null(_) | MaterialKind::ThinDielectric(_)));
     }
 
     /// The share of next-event light choices made by power under `LightSelection::Power`; the

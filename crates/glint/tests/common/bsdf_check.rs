@@ -10,7 +10,7 @@
 //! A new BSDF is tested by adding one `BsdfCase` to the list in `tests/bsdf_sampling.rs`.
 
 use super::stats::{chi2_survival, Estimate};
-use glint::bsdf::ShadedBsdf;
+use glint::materials::ShadedBsdf;
 use glint::math::Vec3;
 use glint::sampling::Rng;
 

@@ -5,9 +5,9 @@
 use super::props::Props;
 use super::spectrum::SpectrumUse;
 use super::Reader;
-use crate::bsdf::{EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
 use crate::describe::{HairDesc, MaterialModel};
 use crate::error::Error;
+use crate::materials::{EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
 use crate::math::Rgb;
 
 impl<'a> Reader<'a> {

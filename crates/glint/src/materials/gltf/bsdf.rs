@@ -23,10 +23,10 @@
 //! `KHR_materials_volume` gives them); btdf is the thin wall's mirrored GGX lobe or Walter's
 //! refraction through the microfacet (radiance scaled by 1/eta² as everywhere in glint).
 
-use super::gltf_lobes::{
+use super::lobes::{
     charlie_d, charlie_vis, schlick_weight, sheen_albedo, sheen_alpha, vis_height_correlated, vis_separable,
 };
-use super::{fresnel_dielectric, BsdfSample, Microfacet, MicrofacetKind, Scatter};
+use crate::bsdf::{fresnel_dielectric, BsdfSample, Microfacet, MicrofacetKind, Scatter};
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
 

@@ -8,7 +8,7 @@
 //! The main lobe is anisotropic GGX with visible-normal sampling; `microfacet.rs` is
 //! isotropic, so the anisotropic distribution lives here ([`AnisoGgx`]).
 
-use super::{fresnel_dielectric, BsdfSample, Scatter};
+use crate::bsdf::{fresnel_dielectric, BsdfSample, Scatter};
 use crate::math::{Rgb, Vec3, INV_PI, PI};
 use crate::sampling::warp;
 

@@ -1,9 +1,16 @@
 //! The textured glTF material: what a hit evaluates into a [`GltfPbr`], and glTF textures
 //! (an image with its sampler, texture coordinate set and `KHR_texture_transform`).
 
-use super::TexturePoint;
-use crate::bsdf::GltfPbr;
-use crate::describe::GltfWrap;
+mod bsdf;
+mod lobes;
+
+pub use bsdf::GltfPbr;
+pub use lobes::{sheen_albedo, sheen_albedo_quadrature, SHEEN_ALBEDO_TOLERANCE, SHEEN_MIN_ROUGHNESS};
+
+use super::{Black, Bsdf};
+use super::{MaskMaterial, MaterialKind, NormalMapMaterial, Shade, Texture, TextureCache, TexturePoint};
+use crate::describe::{GltfAlphaMode, GltfMaterialDesc, GltfWrap};
+use crate::error::Error;
 use crate::io::gltf::RgbaImage;
 use crate::math::{rgb, Rgb};
 use std::sync::Arc;
@@ -265,6 +272,76 @@ impl GltfMaterial {
         });
         self.factors.base_color * t
     }
+}
+
+impl Shade for GltfMaterial {
+    #[inline]
+    fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
+        if self.unlit {
+            return Bsdf::Black(Black);
+        }
+        Bsdf::GltfPbr(self.bsdf(p))
+    }
+
+    fn albedo(&self, uv: [f32; 2]) -> Rgb {
+        GltfMaterial::albedo(self, uv)
+    }
+
+    fn is_transmissive(&self) -> bool {
+        GltfMaterial::is_transmissive(self)
+    }
+
+    fn nested(&self) -> Option<&MaterialKind> {
+        None
+    }
+}
+
+/// The material kind of a glTF material: the textured [`GltfMaterial`], inside a normal
+/// map and a mask where it has them.
+pub(crate) fn build(g: &GltfMaterialDesc, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
+    let base_color_texture = textures.optional_gltf(&g.base_color_texture)?;
+    let factors = GltfPbr {
+        base_color: g.base_color,
+        metallic: g.metallic,
+        roughness: g.roughness,
+        ior: g.ior,
+        specular: g.specular,
+        specular_color: g.specular_color,
+        transmission: g.transmission,
+        thin_walled: g.thin_walled,
+        clearcoat: g.clearcoat,
+        clearcoat_roughness: g.clearcoat_roughness,
+        sheen_color: g.sheen_color,
+        sheen_roughness: g.sheen_roughness,
+    };
+    let mut kind = MaterialKind::Gltf(GltfMaterial {
+        factors,
+        base_color_texture: base_color_texture.clone(),
+        metallic_roughness_texture: textures.optional_gltf(&g.metallic_roughness_texture)?,
+        extension_textures: GltfExtensionTextures {
+            specular: textures.optional_gltf(&g.specular_texture)?,
+            specular_color: textures.optional_gltf(&g.specular_color_texture)?,
+            transmission: textures.optional_gltf(&g.transmission_texture)?,
+            clearcoat: textures.optional_gltf(&g.clearcoat_texture)?,
+            clearcoat_roughness: textures.optional_gltf(&g.clearcoat_roughness_texture)?,
+            sheen_color: textures.optional_gltf(&g.sheen_color_texture)?,
+            sheen_roughness: textures.optional_gltf(&g.sheen_roughness_texture)?,
+        },
+        unlit: g.unlit,
+    });
+    if let Some(n) = textures.optional_gltf(&g.normal_texture)? {
+        let mut n = (*n).clone();
+        n.normal_scale = Some(g.normal_scale);
+        kind =
+            MaterialKind::NormalMap(NormalMapMaterial { normals: Texture::Gltf(Arc::new(n)), nested: Box::new(kind) });
+    }
+    let cutoff = match g.alpha {
+        GltfAlphaMode::Opaque => return Ok(kind),
+        GltfAlphaMode::Mask { cutoff } => Some(cutoff),
+        GltfAlphaMode::Blend => None,
+    };
+    let alpha = GltfAlpha { factor: g.base_alpha, texture: base_color_texture, cutoff };
+    Ok(MaterialKind::Mask(MaskMaterial { opacity: Texture::GltfAlpha(Arc::new(alpha)), nested: Box::new(kind) }))
 }
 
 #[cfg(test)]

@@ -8,7 +8,8 @@
 //! shadowing function to solve the bump terminator problem"), which hides the hard
 //! terminator a tilted normal otherwise draws.
 
-use super::{Bsdf, BsdfSample};
+use super::Bsdf;
+use crate::bsdf::BsdfSample;
 use crate::math::{Frame, Rgb, Vec3};
 
 /// The BSDF a surface scatters with, and the tilted frame (expressed in the surface's shading
@@ -122,7 +123,7 @@ pub fn flip_invalid(n: Vec3, wo: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::Diffuse;
+    use crate::materials::Diffuse;
     use crate::math::vec3;
     use crate::sampling::Rng;
 

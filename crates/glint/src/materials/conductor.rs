@@ -1,0 +1,185 @@
+//! `conductor` and `roughconductor`: metal with a complex index of refraction `eta` + i`k`
+//! per channel, tinted by `specular`; smooth, or rough with a (textured) microfacet
+//! roughness (BSDFs: [`Conductor`], [`RoughConductor`]).
+//!
+//! # The BSDF
+//! Metals (Mitsuba's `conductor` and `roughconductor`): Fresnel reflection with a complex
+//! index of refraction per channel, off a perfect mirror or a microfacet surface.
+
+use super::{roughness_map, Bsdf, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
+use crate::bsdf::{fresnel_conductor, reflect_local, BsdfSample, Microfacet, Scatter};
+use crate::describe::Roughness;
+use crate::error::Error;
+use crate::math::{Rgb, Vec3};
+
+/// Perfectly smooth metal.
+#[derive(Clone, Copy, Debug)]
+pub struct Conductor {
+    pub eta: Rgb,
+    pub k: Rgb,
+    pub specular: Rgb,
+}
+
+/// Microfacet metal (GGX or Beckmann).
+#[derive(Clone, Copy, Debug)]
+pub struct RoughConductor {
+    pub dist: Microfacet,
+    pub eta: Rgb,
+    pub k: Rgb,
+    pub specular: Rgb,
+}
+
+impl Scatter for Conductor {
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        true
+    }
+
+    fn eval(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::BLACK
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+
+    fn sample(&self, wo: Vec3, _u_lobe: f32, _u: [f32; 2]) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = reflect_local(wo);
+        Some(BsdfSample {
+            wi,
+            weight: self.specular * fresnel_conductor(wo.z, self.eta, self.k),
+            pdf: 1.0,
+            delta: true,
+            eta: 1.0,
+        })
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        Rgb::BLACK
+    }
+}
+
+impl Scatter for RoughConductor {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        false
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::BLACK;
+        }
+        let h = (wo + wi).normalize();
+        let d = self.dist.d(h);
+        if d == 0.0 {
+            return Rgb::BLACK;
+        }
+        let f = fresnel_conductor(wi.dot(h), self.eta, self.k);
+        let g = self.dist.g(wo, wi, h);
+        self.specular * f * (d * g / (4.0 * wo.z))
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let h = (wo + wi).normalize();
+        self.dist.pdf_wm(wo, h) / (4.0 * wo.dot(h))
+    }
+
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let h = self.dist.sample_wm(wo, u);
+        let wi = (h * (2.0 * wo.dot(h)) - wo).normalize();
+        BsdfSample::non_delta(wi, self.eval(wo, wi), self.pdf(wo, wi))
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        Rgb::BLACK
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct ConductorMaterial {
+    pub eta: Rgb,
+    pub k: Rgb,
+    pub specular: Rgb,
+}
+
+#[derive(Clone, Debug)]
+pub struct RoughConductorMaterial {
+    pub dist: RoughnessMap,
+    pub eta: Rgb,
+    pub k: Rgb,
+    pub specular: Rgb,
+}
+
+/// The smooth or rough conductor a description gives.
+pub(crate) fn build(
+    eta: Rgb,
+    k: Rgb,
+    specular: Rgb,
+    roughness: Option<&Roughness>,
+    textures: &mut TextureCache,
+) -> Result<MaterialKind, Error> {
+    Ok(match roughness {
+        None => MaterialKind::Conductor(ConductorMaterial { eta, k, specular }),
+        Some(r) => {
+            MaterialKind::RoughConductor(RoughConductorMaterial { dist: roughness_map(r, textures)?, eta, k, specular })
+        }
+    })
+}
+
+impl Shade for ConductorMaterial {
+    #[inline]
+    fn bsdf_at(&self, _p: &TexturePoint) -> Bsdf {
+        Bsdf::Conductor(Conductor { eta: self.eta, k: self.k, specular: self.specular })
+    }
+
+    fn albedo(&self, _uv: [f32; 2]) -> Rgb {
+        self.specular
+    }
+
+    fn is_transmissive(&self) -> bool {
+        false
+    }
+
+    fn nested(&self) -> Option<&MaterialKind> {
+        None
+    }
+}
+
+impl Shade for RoughConductorMaterial {
+    #[inline]
+    fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
+        Bsdf::RoughConductor(RoughConductor {
+            dist: self.dist.at(p.uv),
+            eta: self.eta,
+            k: self.k,
+            specular: self.specular,
+        })
+    }
+
+    fn albedo(&self, _uv: [f32; 2]) -> Rgb {
+        self.specular
+    }
+
+    fn is_transmissive(&self) -> bool {
+        false
+    }
+
+    fn nested(&self) -> Option<&MaterialKind> {
+        None
+    }
+}

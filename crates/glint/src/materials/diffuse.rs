@@ -1,0 +1,93 @@
+//! `diffuse`: Lambertian reflection of a textured `reflectance` (BSDF: [`Diffuse`]).
+//!
+//! # The BSDF
+//! Lambertian reflection (Mitsuba's `diffuse`).
+
+use super::{Bsdf, Shade, Texture, TextureCache, TexturePoint};
+use crate::bsdf::{BsdfSample, Scatter};
+use crate::describe::TextureDesc;
+use crate::error::Error;
+use crate::math::{Rgb, Vec3, INV_PI};
+use crate::sampling::warp;
+
+/// Reflects `reflectance` of the light, evenly in every direction of the upper hemisphere.
+#[derive(Clone, Copy, Debug)]
+pub struct Diffuse {
+    pub reflectance: Rgb,
+}
+
+impl Scatter for Diffuse {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        false
+    }
+
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::BLACK;
+        }
+        self.reflectance * (INV_PI * wi.z)
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            0.0
+        } else {
+            warp::cosine_hemisphere_pdf(wi.z)
+        }
+    }
+
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = warp::cosine_hemisphere(u);
+        if wi.z <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            weight: self.reflectance,
+            pdf: warp::cosine_hemisphere_pdf(wi.z),
+            delta: false,
+            eta: 1.0,
+        })
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        self.reflectance
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct DiffuseMaterial {
+    pub reflectance: Texture,
+}
+
+impl DiffuseMaterial {
+    pub(crate) fn build(reflectance: &TextureDesc, textures: &mut TextureCache) -> Result<DiffuseMaterial, Error> {
+        Ok(DiffuseMaterial { reflectance: textures.texture(reflectance)? })
+    }
+}
+
+impl Shade for DiffuseMaterial {
+    #[inline]
+    fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
+        Bsdf::Diffuse(Diffuse { reflectance: self.reflectance.eval_at(p) })
+    }
+
+    fn albedo(&self, uv: [f32; 2]) -> Rgb {
+        self.reflectance.eval(uv)
+    }
+
+    fn is_transmissive(&self) -> bool {
+        false
+    }
+
+    fn nested(&self) -> Option<&super::MaterialKind> {
+        None
+    }
+}

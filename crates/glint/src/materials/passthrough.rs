@@ -1,0 +1,114 @@
+//! The two materials without parameters: `black` absorbs everything (emitters without a
+//! material), `null` lets light through unchanged (Mitsuba's `null`: a medium's boundary).
+//! Their BSDFs ([`Black`], [`Null`]) are their built form.
+//!
+//! # The BSDF
+//! The two BSDFs without parameters: [`Black`] absorbs everything (emitters without a
+//! material), [`Null`] passes light straight through unchanged (Mitsuba's `null`: the
+//! boundary of a medium).
+
+use super::{Bsdf, MaterialKind, Shade, TexturePoint};
+use crate::bsdf::{BsdfSample, Scatter};
+use crate::math::{Rgb, Vec3};
+
+/// Absorbs everything.
+#[derive(Clone, Copy, Debug)]
+pub struct Black;
+
+/// Passes light straight through, unchanged.
+#[derive(Clone, Copy, Debug)]
+pub struct Null;
+
+impl Scatter for Black {
+    fn is_delta(&self) -> bool {
+        false
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        false
+    }
+
+    fn eval(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::BLACK
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+
+    fn sample(&self, _wo: Vec3, _u_lobe: f32, _u: [f32; 2]) -> Option<BsdfSample> {
+        None
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        Rgb::BLACK
+    }
+}
+
+impl Scatter for Null {
+    fn is_delta(&self) -> bool {
+        true
+    }
+
+    fn has_delta_lobe(&self) -> bool {
+        true
+    }
+
+    fn eval(&self, _wo: Vec3, _wi: Vec3) -> Rgb {
+        Rgb::BLACK
+    }
+
+    fn pdf(&self, _wo: Vec3, _wi: Vec3) -> f32 {
+        0.0
+    }
+
+    fn sample(&self, wo: Vec3, _u_lobe: f32, _u: [f32; 2]) -> Option<BsdfSample> {
+        Some(BsdfSample { wi: -wo, weight: Rgb::WHITE, pdf: 1.0, delta: true, eta: 1.0 })
+    }
+
+    fn diffuse_reflectance(&self) -> Rgb {
+        Rgb::BLACK
+    }
+
+    fn passage_transmission(&self, _wo: Vec3) -> Option<Rgb> {
+        Some(Rgb::WHITE)
+    }
+}
+
+impl Shade for Black {
+    #[inline]
+    fn bsdf_at(&self, _p: &TexturePoint) -> Bsdf {
+        Bsdf::Black(Black)
+    }
+
+    fn albedo(&self, _uv: [f32; 2]) -> Rgb {
+        Rgb::BLACK
+    }
+
+    fn is_transmissive(&self) -> bool {
+        false
+    }
+
+    fn nested(&self) -> Option<&MaterialKind> {
+        None
+    }
+}
+
+impl Shade for Null {
+    #[inline]
+    fn bsdf_at(&self, _p: &TexturePoint) -> Bsdf {
+        Bsdf::Null(Null)
+    }
+
+    fn albedo(&self, _uv: [f32; 2]) -> Rgb {
+        Rgb::WHITE
+    }
+
+    fn is_transmissive(&self) -> bool {
+        true
+    }
+
+    fn nested(&self) -> Option<&MaterialKind> {
+        None
+    }
+}
