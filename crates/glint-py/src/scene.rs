@@ -1,8 +1,9 @@
 //! `Scene`: a loaded scene, its built world and mesh cache (a library session).
 
 use crate::convert::{guard, scene_error};
-use glint::describe::{Geometry, MeshData, SceneDesc};
+use glint::describe::{Geometry, MeshData};
 use glint::formats::{Define, ReadOptions};
+use glint::materials::SceneDesc;
 use glint::math::{Rgb, Vec3};
 use glint::session::{Param, ParamValue, Session};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};

@@ -15,7 +15,7 @@ use glint::assemble::WorldBuilder;
 use glint::geometry::cube_mesh;
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::LightSelection;
-use glint::materials::{ConductorMaterial, DielectricMaterial, Material, MaterialKind, ThinDielectricMaterial};
+use glint::materials::{ConductorMaterial, DielectricMaterial, DielectricSurface, Material, MaterialKind};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::world::World;
 use std::sync::Arc;
@@ -29,7 +29,7 @@ const BLOCK: usize = 4;
 const FLOAT_TOLERANCE: f32 = 1e-5;
 
 fn glass() -> MaterialKind {
-    MaterialKind::Dielectric(DielectricMaterial { eta: ETA, reflect: Rgb::WHITE, transmit: Rgb::WHITE })
+    MaterialKind::Dielectric(DielectricMaterial::smooth(ETA, Rgb::WHITE, Rgb::WHITE))
 }
 
 fn scene_with(kind: MaterialKind, eye: Vec3) -> World {
@@ -79,14 +79,21 @@ fn glass_in_a_furnace_is_invisible() {
 
 #[test]
 fn thin_glass_in_a_furnace_is_invisible() {
-    let thin =
-        MaterialKind::ThinDielectric(ThinDielectricMaterial { eta: ETA, reflect: Rgb::WHITE, transmit: Rgb::WHITE });
+    let thin = MaterialKind::Dielectric(DielectricMaterial {
+        surface: DielectricSurface::Thin,
+        ..DielectricMaterial::smooth(ETA, Rgb::WHITE, Rgb::WHITE)
+    });
     check("thin glass", &scene_with(thin, OUTSIDE), LE);
 }
 
 #[test]
 fn perfect_mirror_in_a_furnace_is_invisible() {
-    let mirror = MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::WHITE });
+    let mirror = MaterialKind::Conductor(ConductorMaterial {
+        eta: Rgb::BLACK,
+        k: Rgb::WHITE,
+        specular: Rgb::WHITE,
+        roughness: None,
+    });
     check("mirror", &scene_with(mirror, OUTSIDE), LE);
 }
 

@@ -5,8 +5,9 @@
 mod common;
 
 use common::scratch::ScratchDir;
-use glint::describe::{GridFilter, GridWrap, IntegratorDesc, PhaseDesc, SceneDesc, VolumeDesc};
+use glint::describe::{GridFilter, GridWrap, IntegratorDesc, PhaseDesc, VolumeDesc};
 use glint::formats::{json, mitsuba};
+use glint::materials::SceneDesc;
 use glint::math::Rgb;
 use std::path::Path;
 

@@ -12,7 +12,7 @@ use glint::assemble::WorldBuilder;
 use glint::bsdf::{Microfacet, MicrofacetKind};
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::{AreaEmission, LightSelection};
-use glint::materials::{Material, MaterialKind, RoughConductorMaterial};
+use glint::materials::{ConductorMaterial, Material, MaterialKind};
 use glint::math::{rgb, vec3, Rgb, Transform, Vec3};
 use glint::world::World;
 
@@ -28,7 +28,7 @@ fn glossy(b: &mut WorldBuilder, name: &str, dist: Microfacet) -> u32 {
     let dist = dist.into();
     b.add_material(Material::new(
         name,
-        MaterialKind::RoughConductor(RoughConductorMaterial { dist, eta, k, specular: Rgb::WHITE }),
+        MaterialKind::Conductor(ConductorMaterial { roughness: Some(dist), eta, k, specular: Rgb::WHITE }),
         true,
     ))
 }

@@ -6,8 +6,10 @@ mod common;
 
 use common::load::load;
 use common::scratch::ScratchDir;
-use glint::describe::{Geometry, LightKind, MaterialModel, SceneDesc, TextureDesc};
+use glint::describe::{Geometry, LightKind, TextureDesc};
 use glint::formats::{Define, ReadOptions};
+use glint::materials::{ConductorDesc, DiffuseDesc};
+use glint::materials::{MaterialModel, SceneDesc};
 use std::path::{Path, PathBuf};
 
 /// A fresh folder for one test's files, removed when the test ends.
@@ -77,7 +79,7 @@ fn path_folders_serve_meshes_textures_envmaps_and_includes() {
         other => panic!("{other:?}"),
     }
     match &desc.materials[0].model {
-        MaterialModel::Diffuse { reflectance: TextureDesc::Bitmap { file, .. } } => {
+        MaterialModel::Diffuse(DiffuseDesc { reflectance: TextureDesc::Bitmap { file, .. } }) => {
             same(file, &dir.join("common/textures/t.png"))
         }
         other => panic!("{other:?}"),
@@ -145,7 +147,7 @@ fn scene_level_sampler_and_film() {
 }
 
 /// The uniform radiance shape `i` emits.
-fn emitted(d: &glint::describe::SceneDesc, i: usize) -> glint::math::Rgb {
+fn emitted(d: &glint::materials::SceneDesc, i: usize) -> glint::math::Rgb {
     match &d.shapes[i].emission.as_ref().expect("the shape emits").radiance {
         glint::describe::TextureDesc::Constant { color } => *color,
         t => panic!("shape {i} emits a texture: {t:?}"),
@@ -184,13 +186,13 @@ fn spectra_convert_as_in_mitsubas_rgb_variants() {
     );
     let d = read(&p).unwrap();
     let diffuse = |i: usize| match &d.materials[i].model {
-        MaterialModel::Diffuse { reflectance: TextureDesc::Constant { color } } => *color,
+        MaterialModel::Diffuse(DiffuseDesc { reflectance: TextureDesc::Constant { color } }) => *color,
         other => panic!("{other:?}"),
     };
     close(diffuse(0), [0.776368, 0.779809, 0.776029], 1e-5);
     close(emitted(&d, 0), [20.7108, 10.8546, 2.77115], 1e-5);
     match &d.materials[1].model {
-        MaterialModel::Conductor { eta, k, .. } => {
+        MaterialModel::Conductor(ConductorDesc { eta, k, .. }) => {
             close(*eta, [0.27, 0.27, 0.27], 0.0);
             // Unbounded: through D65, clamped at 0 only (mi.spectrum_list_to_srgb(..., False, True)).
             close(*k, [3.3887, 2.34904, 1.87516], 1e-5);

@@ -3,8 +3,10 @@
 //! `pplastic` and `polarizer`; and the JSON format's equivalents.
 
 use glint::bsdf::MicrofacetKind;
-use glint::describe::{MaterialModel, Roughness, ScalarTexture, SceneDesc, TextureDesc};
+use glint::describe::{Roughness, ScalarTexture, TextureDesc};
 use glint::formats::mitsuba::read_str;
+use glint::materials::{ConductorDesc, DielectricDesc, PPlasticDesc, PlasticDesc};
+use glint::materials::{MaterialModel, SceneDesc};
 use glint::math::Rgb;
 use std::path::Path;
 
@@ -28,10 +30,10 @@ fn error(bsdf: &str) -> String {
 
 fn roughness_of(m: &MaterialModel) -> Roughness {
     match m {
-        MaterialModel::Conductor { roughness: Some(r), .. }
-        | MaterialModel::Dielectric { roughness: Some(r), .. }
-        | MaterialModel::Plastic { roughness: Some(r), .. }
-        | MaterialModel::PPlastic { roughness: r, .. } => r.clone(),
+        MaterialModel::Conductor(ConductorDesc { roughness: Some(r), .. })
+        | MaterialModel::Dielectric(DielectricDesc { roughness: Some(r), .. })
+        | MaterialModel::Plastic(PlasticDesc { roughness: Some(r), .. })
+        | MaterialModel::PPlastic(PPlasticDesc { roughness: r, .. }) => r.clone(),
         other => panic!("no roughness in {other:?}"),
     }
 }
@@ -85,15 +87,15 @@ fn roughness_combinations_mitsuba_rejects_are_errors() {
 #[test]
 fn nonlinear_pplastic_and_polarizer() {
     match model(r#"<bsdf type="roughplastic"><boolean name="nonlinear" value="true"/></bsdf>"#) {
-        MaterialModel::Plastic { nonlinear: true, roughness: Some(_), .. } => {}
+        MaterialModel::Plastic(PlasticDesc { nonlinear: true, roughness: Some(_), .. }) => {}
         other => panic!("{other:?}"),
     }
     match model(r#"<bsdf type="plastic"/>"#) {
-        MaterialModel::Plastic { nonlinear: false, roughness: None, .. } => {}
+        MaterialModel::Plastic(PlasticDesc { nonlinear: false, roughness: None, .. }) => {}
         other => panic!("{other:?}"),
     }
     match model(r#"<bsdf type="pplastic"><rgb name="diffuse_reflectance" value="0.05, 0.03, 0.1"/></bsdf>"#) {
-        MaterialModel::PPlastic { eta, roughness, specular, .. } => {
+        MaterialModel::PPlastic(PPlasticDesc { eta, roughness, specular, .. }) => {
             assert!((eta - 1.49 / 1.000277).abs() < 1e-6, "polypropylene in air: {eta}");
             assert_eq!(roughness, Roughness::isotropic(MicrofacetKind::Beckmann, 0.1));
             assert_eq!(specular, Rgb::WHITE);
@@ -101,7 +103,7 @@ fn nonlinear_pplastic_and_polarizer() {
         other => panic!("{other:?}"),
     }
     match model(r#"<bsdf type="polarizer"><spectrum name="theta" value="90"/></bsdf>"#) {
-        MaterialModel::Dielectric { eta, reflect, transmit, roughness: None, thin: true } => {
+        MaterialModel::Dielectric(DielectricDesc { eta, reflect, transmit, roughness: None, thin: true }) => {
             assert_eq!((eta, reflect, transmit), (1.0, Rgb::BLACK, Rgb::splat(0.5)));
         }
         other => panic!("{other:?}"),
@@ -127,8 +129,8 @@ fn json_takes_textured_and_anisotropic_alpha_and_a_plain_number() {
     let r = roughness_of(&by_name("brushed"));
     assert_eq!(r.alpha, ScalarTexture::Value(0.05));
     assert!(matches!(r.alpha_v, Some(ScalarTexture::Texture(TextureDesc::Checkerboard { .. }))), "{r:?}");
-    assert!(matches!(by_name("paint"), MaterialModel::Plastic { nonlinear: true, .. }));
-    assert!(matches!(by_name("pp"), MaterialModel::PPlastic { .. }));
+    assert!(matches!(by_name("paint"), MaterialModel::Plastic(PlasticDesc { nonlinear: true, .. })));
+    assert!(matches!(by_name("pp"), MaterialModel::PPlastic(_)));
     // The description round-trips through serde with the new fields.
     let back: SceneDesc = serde_json::from_str(&serde_json::to_string(&d).unwrap()).unwrap();
     assert_eq!(back, d);

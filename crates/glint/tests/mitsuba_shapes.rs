@@ -6,9 +6,10 @@ mod common;
 use common::scratch::ScratchDir;
 use glint::assemble::{build, BuildOptions};
 use glint::camera::{CropWindow, Projection};
-use glint::describe::{Geometry, LightKind, SceneDesc, TextureDesc};
+use glint::describe::{Geometry, LightKind, TextureDesc};
 use glint::formats::mitsuba::read_str;
 use glint::lights::Light;
+use glint::materials::SceneDesc;
 use glint::math::{rgb, vec3, Ray, Rgb, Vec3};
 use std::path::Path;
 

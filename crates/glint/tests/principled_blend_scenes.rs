@@ -6,7 +6,8 @@ mod common;
 
 use common::load::load;
 use common::scratch::ScratchDir;
-use glint::describe::{MaterialModel, TextureDesc};
+use glint::describe::TextureDesc;
+use glint::materials::MaterialModel;
 use std::path::{Path, PathBuf};
 
 /// A folder for one test's files: tests run in parallel, so each needs its own.

@@ -148,13 +148,9 @@ fn gltf_primitive(
 /// Material for an MTL entry (used when an OBJ shape names no material).
 fn material_from_mtl(m: &obj::MtlMaterial) -> Material {
     let kind = if m.illum == 7 || m.dissolve < 1.0 {
-        MaterialKind::Dielectric(DielectricMaterial {
-            eta: m.ni.max(1.0001),
-            reflect: Rgb::WHITE,
-            transmit: Rgb::WHITE,
-        })
+        MaterialKind::Dielectric(DielectricMaterial::smooth(m.ni.max(1.0001), Rgb::WHITE, Rgb::WHITE))
     } else if m.illum == 5 {
-        MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: m.ks })
+        MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: m.ks, roughness: None })
     } else if m.ks.max_component() > 0.0 && m.ns > 0.0 {
         MaterialKind::Phong(PhongMaterial { kd: Texture::Constant(m.kd), ks: m.ks, exponent: m.ns })
     } else {

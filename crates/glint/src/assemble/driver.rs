@@ -11,14 +11,12 @@ use super::builder::{bake, environment_lights, read_mesh_file};
 use super::{add_light, camera, material_id, mesh_loc, transform_of, validate};
 use super::{BuildOptions, LoadedGroup, WorldBuilder};
 use crate::accel::BvhSplit;
-use crate::describe::{
-    CurveBasisDesc, Emission, Geometry, MaterialDesc, MaterialModel, MaterialRef, Matrix4, SceneDesc, SdfNormalsDesc,
-    ShapeDesc,
-};
+use crate::describe::{CurveBasisDesc, Emission, Geometry, MaterialRef, Matrix4, SdfNormalsDesc, ShapeDesc};
 use crate::error::{Error, SourceLoc};
 use crate::geometry::{cube_mesh, disk_mesh, rectangle_mesh, CurveBasis, SdfNormals, TriangleMesh};
 use crate::lights::{AreaEmission, Light};
-use crate::materials::{Material, MaterialKind, TextureCache};
+use crate::materials::{Material, TextureCache};
+use crate::materials::{MaterialDesc, MaterialModel, SceneDesc};
 use crate::math::Transform;
 use crate::world::World;
 use rayon::prelude::*;
@@ -309,7 +307,7 @@ fn add_shape(
 
 /// A described material, built: its kind with textures loaded, its sides.
 fn material(m: &MaterialDesc, textures: &mut TextureCache) -> Result<Material, Error> {
-    let kind = MaterialKind::build(&m.model, textures).map_err(|e| e.or_at(&m.loc))?;
+    let kind = m.model.build(textures).map_err(|e| e.or_at(&m.loc))?;
     let mut out = Material::new(m.name.clone(), kind, m.two_sided);
     if let MaterialModel::Gltf(g) = &m.model {
         out.cull_back_faces = g.culls_back_faces();

@@ -1,9 +1,11 @@
 //! Media of a description: checked (every number finite and in range, every index in
 //! bounds) and turned into the world's [`Medium`]s.
 
-use crate::describe::{GridVolumeDesc, MediumDesc, PhaseDesc, SceneDesc, VolumeDesc};
+use crate::describe::{GridVolumeDesc, MediumDesc, PhaseDesc, VolumeDesc};
+
 use crate::error::{Error, SourceLoc};
 use crate::io::vol::read_vol;
+use crate::materials::SceneDesc;
 use crate::math::{Mat4, Transform};
 use crate::media::{Albedo, GridVolume, Medium, MediumBoundary, Phase};
 use std::sync::Arc;

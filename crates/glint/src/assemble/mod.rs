@@ -15,9 +15,10 @@ pub use driver::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
 
 use crate::accel::BvhSplit;
 use crate::camera::Camera;
-use crate::describe::{CameraDesc, Geometry, LightKind, MaterialRef, Matrix4, SceneDesc};
+use crate::describe::{CameraDesc, Geometry, LightKind, MaterialRef, Matrix4};
 use crate::error::{Error, SourceLoc};
 use crate::lights::{Light, ProjectedKind, ProjectedLight};
+use crate::materials::SceneDesc;
 use crate::materials::{Texture, TextureCache};
 use crate::math::{Aabb, Frame, Mat4, Transform, Vec3};
 use crate::world::World;

@@ -2,11 +2,11 @@
 //! finite and in its range, so that no NaN or infinity reaches the BVH or the integrators.
 //! Each error names the entity's source location and the allowed range.
 
-use crate::describe::{
-    CameraDesc, FilmDesc, Geometry, IntegratorDesc, LightKind, MaterialModel, Matrix4, PixelFilter, SceneDesc,
-    TextureDesc,
-};
+use crate::describe::{CameraDesc, FilmDesc, Geometry, IntegratorDesc, LightKind, Matrix4, PixelFilter};
+
+use crate::describe::checks::{color, texture};
 use crate::error::{Error, SourceLoc};
+use crate::materials::SceneDesc;
 use crate::math::{Rgb, Vec3};
 
 use crate::describe::limits::{check_resolution, MAX_DIRECT_SAMPLES, MAX_SPP, MAX_WHITTED_DEPTH};
@@ -59,7 +59,7 @@ pub fn check(d: &SceneDesc) -> Result<(), Error> {
         if !names.insert(m.name.as_str()) {
             return Err(Error::at(&m.loc, format!("material '{}' is defined twice", m.name)));
         }
-        material(&m.model).map_err(|e| Error::at(&m.loc, format!("material '{}': {e}", m.name)))?;
+        m.model.validate().map_err(|e| Error::at(&m.loc, format!("material '{}': {e}", m.name)))?;
     }
     for s in &d.shapes {
         matrix(&s.to_world, "to_world").map_err(|m| Error::at(&s.loc, m))?;
@@ -152,206 +152,6 @@ fn camera(c: &CameraDesc) -> Result<(), Error> {
     Ok(())
 }
 
-/// A texture's colours (named `what` when constant), uv transform and attribute name.
-fn texture(t: &TextureDesc, what: &str) -> Result<(), String> {
-    match t {
-        TextureDesc::Constant { color: c } => color(*c, what)?,
-        TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {
-            color(*color0, "color0")?;
-            color(*color1, "color1")?;
-            uv(uv_scale, uv_offset)?;
-        }
-        TextureDesc::Bitmap { uv_scale, uv_offset, .. } => uv(uv_scale, uv_offset)?,
-        TextureDesc::MeshAttribute { name, scale, .. } => {
-            if !scale.is_finite() {
-                return Err(format!("mesh attribute '{name}': scale {scale} must be finite"));
-            }
-            if !(name.starts_with("vertex_") || name.starts_with("face_")) {
-                return Err(format!("mesh attribute name '{name}' must start with 'vertex_' or 'face_'"));
-            }
-        }
-        TextureDesc::Gltf(g) => {
-            color(g.scale, what)?;
-            if g.texcoord > 1 {
-                return Err(format!("glTF texture coordinate set {} (glint reads sets 0 and 1)", g.texcoord));
-            }
-            if g.transform.iter().flatten().any(|v| !v.is_finite()) {
-                return Err("glTF texture transform must be finite".into());
-            }
-        }
-    }
-    Ok(())
-}
-
-fn material(m: &MaterialModel) -> Result<(), String> {
-    for t in m.textures() {
-        texture(t, "colour")?;
-    }
-    let alpha = |r: &Option<crate::describe::Roughness>| -> Result<(), String> {
-        let Some(r) = r else { return Ok(()) };
-        // A constant alpha must be positive (0 is a smooth surface, described as such); a
-        // textured one may reach 0 where it is checked as a colour, and is clamped, as
-        // Mitsuba clamps it, to 1e-4.
-        for (name, value) in [("alpha", Some(&r.alpha)), ("alpha_v", r.alpha_v.as_ref())] {
-            if let Some(crate::describe::ScalarTexture::Value(a)) = value {
-                if !(*a > 0.0 && a.is_finite()) {
-                    return Err(format!("roughness {name} {a} must be positive and finite"));
-                }
-            }
-        }
-        Ok(())
-    };
-    let eta_ok = |eta: f32| -> Result<(), String> {
-        if eta > 0.0 && eta.is_finite() {
-            Ok(())
-        } else {
-            Err(format!("index of refraction {eta} must be positive and finite"))
-        }
-    };
-    match m {
-        MaterialModel::Phong { ks, exponent, .. } => {
-            color(*ks, "ks")?;
-            if !(*exponent >= 0.0 && exponent.is_finite()) {
-                return Err(format!("Phong exponent {exponent} must be finite and at least 0"));
-            }
-        }
-        MaterialModel::Conductor { eta, k, specular, roughness } => {
-            color(*eta, "eta")?;
-            color(*k, "k")?;
-            color(*specular, "specular reflectance")?;
-            alpha(roughness)?;
-        }
-        MaterialModel::Dielectric { eta, reflect, transmit, roughness, .. } => {
-            eta_ok(*eta)?;
-            color(*reflect, "specular reflectance")?;
-            color(*transmit, "specular transmittance")?;
-            alpha(roughness)?;
-        }
-        MaterialModel::Plastic { specular, eta, roughness, .. } => {
-            eta_ok(*eta)?;
-            color(*specular, "specular reflectance")?;
-            alpha(roughness)?;
-        }
-        MaterialModel::PPlastic { specular, eta, roughness, .. } => {
-            eta_ok(*eta)?;
-            color(*specular, "specular reflectance")?;
-            alpha(&Some(roughness.clone()))?;
-        }
-        MaterialModel::Diffuse { .. } | MaterialModel::Black | MaterialModel::Null => {}
-        MaterialModel::Hair(h) => {
-            eta_ok(h.eta)?;
-            if !(h.sigma_a.r >= 0.0
-                && h.sigma_a.g >= 0.0
-                && h.sigma_a.b >= 0.0
-                && h.sigma_a.max_component().is_finite())
-            {
-                return Err(format!("hair absorption {:?} must be finite and not negative", h.sigma_a));
-            }
-            for (name, v) in
-                [("longitudinal_roughness", h.longitudinal_roughness), ("azimuthal_roughness", h.azimuthal_roughness)]
-            {
-                if !(0.0..=1.0).contains(&v) {
-                    return Err(format!("hair {name} {v} must be in [0, 1]"));
-                }
-            }
-            if !h.scale_tilt.is_finite() {
-                return Err(format!("hair scale_tilt {} must be finite", h.scale_tilt));
-            }
-        }
-        MaterialModel::BumpMap { scale, nested, .. } => {
-            if !scale.is_finite() {
-                return Err(format!("bump map scale {scale} must be finite"));
-            }
-            material(nested)?;
-        }
-        MaterialModel::NormalMap { nested, .. } | MaterialModel::Mask { nested, .. } => material(nested)?,
-        MaterialModel::Principled(p) => principled(p, eta_ok)?,
-        MaterialModel::Gltf(g) => gltf_material(g, eta_ok)?,
-        MaterialModel::Blend(b) => {
-            // Each part is checked as a material of its own (its textures included).
-            material(&b.first.model).map_err(|e| format!("blend, first part: {e}"))?;
-            material(&b.second.model).map_err(|e| format!("blend, second part: {e}"))?;
-        }
-    }
-    Ok(())
-}
-
-/// A glTF material's factors: the specification's ranges ([0, 1] but for the index of
-/// refraction and the attenuation distance), so that a BSDF never sees a value it has no
-/// meaning for.
-fn gltf_material(
-    g: &crate::describe::GltfMaterialDesc,
-    eta_ok: impl Fn(f32) -> Result<(), String>,
-) -> Result<(), String> {
-    eta_ok(g.ior)?;
-    for (name, c) in [
-        ("baseColorFactor", g.base_color),
-        ("specularColorFactor", g.specular_color),
-        ("sheenColorFactor", g.sheen_color),
-        ("attenuationColor", g.attenuation_color),
-    ] {
-        color(c, name)?;
-    }
-    for (name, v) in [
-        ("alpha", g.base_alpha),
-        ("metallicFactor", g.metallic),
-        ("roughnessFactor", g.roughness),
-        ("specularFactor", g.specular),
-        ("transmissionFactor", g.transmission),
-        ("clearcoatFactor", g.clearcoat),
-        ("clearcoatRoughnessFactor", g.clearcoat_roughness),
-        ("sheenRoughnessFactor", g.sheen_roughness),
-    ] {
-        if !(0.0..=1.0).contains(&v) {
-            return Err(format!("glTF material: {name} {v} must lie in [0, 1]"));
-        }
-    }
-    if !g.normal_scale.is_finite() {
-        return Err(format!("glTF material: normalTexture.scale {} must be finite", g.normal_scale));
-    }
-    if !(g.attenuation_distance > 0.0) {
-        return Err(format!("glTF material: attenuationDistance {} must be positive", g.attenuation_distance));
-    }
-    Ok(())
-}
-
-/// Mitsuba documents every principled parameter but `eta` and the sampling rates as lying
-/// in [0, 1]; out of it the model has no meaning (anisotropic above 1/0.9 is a NaN).
-fn principled(p: &crate::describe::PrincipledDesc, eta_ok: impl Fn(f32) -> Result<(), String>) -> Result<(), String> {
-    eta_ok(p.eta)?;
-    for (name, t) in p.textures() {
-        let unit = |c: Rgb| -> Result<(), String> {
-            if name != "base_color" && c.to_array().iter().any(|v| *v > 1.0) {
-                return Err(format!("principled: {name} ({}, {}, {}) must lie in [0, 1]", c.r, c.g, c.b));
-            }
-            Ok(())
-        };
-        match t {
-            TextureDesc::Constant { color: c } => unit(*c)?,
-            TextureDesc::Checkerboard { color0, color1, .. } => {
-                unit(*color0)?;
-                unit(*color1)?;
-            }
-            // Images are clamped to [0, 1] by their formats or read as given (EXR).
-            TextureDesc::Bitmap { .. } | TextureDesc::MeshAttribute { .. } | TextureDesc::Gltf(_) => {}
-        }
-    }
-    for (rate, name) in [
-        (p.diffuse_sampling_rate, "diffuse_reflectance_sampling_rate"),
-        (p.specular_sampling_rate, "main_specular_sampling_rate"),
-        (p.clearcoat_sampling_rate, "clearcoat_sampling_rate"),
-    ] {
-        if !(rate >= 0.0 && rate.is_finite()) {
-            return Err(format!("principled: {name} {rate} must be finite and not negative"));
-        }
-    }
-    if !(p.specular_sampling_rate > 0.0) {
-        // The main lobe must be sampleable: it is the only one seen from inside.
-        return Err("principled: main_specular_sampling_rate must be positive".to_string());
-    }
-    Ok(())
-}
-
 fn light(l: &LightKind) -> Result<(), String> {
     match l {
         LightKind::Point { position, intensity } => {
@@ -406,14 +206,6 @@ fn light(l: &LightKind) -> Result<(), String> {
     }
 }
 
-fn color(c: Rgb, what: &str) -> Result<(), String> {
-    if c.to_array().iter().all(|v| v.is_finite() && *v >= 0.0) {
-        Ok(())
-    } else {
-        Err(format!("{what} ({}, {}, {}) must be finite and not negative", c.r, c.g, c.b))
-    }
-}
-
 fn vector(v: Vec3, what: &str) -> Result<(), String> {
     if v.is_finite() {
         Ok(())
@@ -455,12 +247,4 @@ fn axis_scales(m: &Matrix4, what: &str) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-fn uv(scale: &[f32; 2], offset: &[f32; 2]) -> Result<(), String> {
-    if scale.iter().chain(offset).all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err("uv scale and offset must be finite".into())
-    }
 }

@@ -20,7 +20,6 @@
 mod fresnel;
 mod microfacet;
 
-pub use crate::describe::principled_eta_of_specular;
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
 pub use microfacet::{
     eval_rough_dielectric, pdf_rough_dielectric, sample_rough_dielectric, Microfacet, MicrofacetKind,

@@ -14,21 +14,18 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 mod aov;
-mod blend;
 mod camera;
+pub mod checks;
 mod gltf;
 mod integrator;
 pub mod limits;
 mod medium;
-mod principled;
 mod sampling;
 pub use aov::Aov;
-pub use blend::{BlendDesc, BlendPartDesc};
 pub use camera::{CropWindow, FovAxis, Projection};
-pub use gltf::{GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, GltfWrap};
+pub use gltf::{GltfTextureDesc, GltfWrap};
 pub use integrator::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
 pub use medium::{GridFilter, GridVolumeDesc, GridWrap, MediumDesc, PhaseDesc, VolumeDesc};
-pub use principled::{principled_eta_of_specular, PrincipledDesc};
 pub use sampling::{LightSelection, PixelFilter, SamplerKind};
 
 /// A 4x4 row-major object-to-world matrix (column vectors: `p' = M p`).
@@ -36,8 +33,19 @@ pub type Matrix4 = [[f64; 4]; 4];
 
 pub const IDENTITY: Matrix4 = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
 
+/// What a description needs of the materials it holds: their textures (the files they read,
+/// and their paths to rewrite). The material set itself is the `materials` module's: a
+/// description is generic over it so that `describe` depends on nothing but `math` and
+/// `error` (`materials::SceneDesc` is the description with glint's materials).
+pub trait MaterialSet {
+    /// Every texture the material reads, in a fixed order.
+    fn textures(&self) -> Vec<&TextureDesc>;
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc>;
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SceneDesc {
+pub struct SceneDesc<M> {
     /// The file the description was read from (`None` when built in code).
     pub source: Option<PathBuf>,
     /// Files the scene file included (Mitsuba's `<include>`).
@@ -47,7 +55,7 @@ pub struct SceneDesc {
     pub integrator: IntegratorDesc,
     pub sampler: SamplerDesc,
     pub light_selection: LightSelection,
-    pub materials: Vec<MaterialDesc>,
+    pub materials: Vec<MaterialDesc<M>>,
     /// Mesh files placed by [`Geometry::Instance`] shapes, loaded once each.
     pub meshes: Vec<MeshFileDesc>,
     pub shapes: Vec<ShapeDesc>,
@@ -123,10 +131,11 @@ impl Default for SamplerDesc {
     }
 }
 
+/// A named material; `model` is one of the material set's descriptions.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct MaterialDesc {
+pub struct MaterialDesc<M> {
     pub name: String,
-    pub model: MaterialModel,
+    pub model: M,
     /// Scatters on both faces (else the back face is black, Mitsuba's default).
     pub two_sided: bool,
     pub loc: SourceLoc,
@@ -185,93 +194,6 @@ impl ScalarTexture {
             ScalarTexture::Value(_) => None,
         }
     }
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase")]
-// Kept unboxed: a description is built once and read once; boxes would only change its API.
-#[allow(clippy::large_enum_variant)]
-pub enum MaterialModel {
-    Diffuse {
-        reflectance: TextureDesc,
-    },
-    Phong {
-        kd: TextureDesc,
-        ks: Rgb,
-        exponent: f32,
-    },
-    /// A smooth (`roughness: None`) or rough metal; eta 0, k 1 is a perfect mirror.
-    Conductor {
-        eta: Rgb,
-        k: Rgb,
-        specular: Rgb,
-        roughness: Option<Roughness>,
-    },
-    /// `eta` is interior over exterior index of refraction.
-    Dielectric {
-        eta: f32,
-        reflect: Rgb,
-        transmit: Rgb,
-        roughness: Option<Roughness>,
-        thin: bool,
-    },
-    Plastic {
-        diffuse: TextureDesc,
-        specular: Rgb,
-        eta: f32,
-        roughness: Option<Roughness>,
-        /// Mitsuba's `nonlinear`: the internal scattering series divides the albedo ρ by
-        /// 1 - ρ F_dr instead of 1 - F_dr, which darkens and saturates colours.
-        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-        nonlinear: bool,
-    },
-    /// Absorbs everything (emitters without a material).
-    Black,
-    /// `nested` shaded with a tangent-space normal map (Mitsuba's `normalmap`).
-    NormalMap {
-        normals: TextureDesc,
-        nested: Box<MaterialModel>,
-    },
-    /// `nested` shaded with the normals of `scale` times a height texture (`bumpmap`).
-    BumpMap {
-        height: TextureDesc,
-        scale: f32,
-        nested: Box<MaterialModel>,
-    },
-    /// `nested` with an opacity: light passes through with probability 1 - opacity (`mask`).
-    Mask {
-        opacity: TextureDesc,
-        nested: Box<MaterialModel>,
-    },
-    /// Lets light through unchanged (Mitsuba's `null`): the boundary of a medium.
-    Null,
-    /// Mitsuba's `principled` BSDF.
-    Principled(PrincipledDesc),
-    /// Mitsuba's `blendbsdf`.
-    Blend(BlendDesc),
-    /// Mitsuba's `pplastic` as its unpolarized variants render it: a rough specular lobe
-    /// over a diffuse base attenuated by Fresnel transmission in and out.
-    PPlastic {
-        diffuse: TextureDesc,
-        specular: Rgb,
-        eta: f32,
-        roughness: Roughness,
-    },
-    /// Mitsuba's `hair` (Chiang et al. 2016): `sigma_a` the absorption per fibre radius (from
-    /// the pigments, or Mitsuba's `sigma_a` times `scale`), `eta` interior over exterior,
-    /// the roughnesses in [0, 1] and the scale tilt in degrees.
-    Hair(HairDesc),
-    /// A glTF 2.0 material (metallic-roughness and its KHR extensions).
-    Gltf(GltfMaterialDesc),
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct HairDesc {
-    pub sigma_a: Rgb,
-    pub eta: f32,
-    pub longitudinal_roughness: f32,
-    pub azimuthal_roughness: f32,
-    pub scale_tilt: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -571,9 +493,9 @@ impl SpotFalloff {
     }
 }
 
-impl SceneDesc {
+impl<M: MaterialSet> SceneDesc<M> {
     /// A description with nothing in it but a camera and film; readers and code fill it.
-    pub fn empty(camera: CameraDesc, film: FilmDesc) -> SceneDesc {
+    pub fn empty(camera: CameraDesc, film: FilmDesc) -> SceneDesc<M> {
         SceneDesc {
             source: None,
             includes: Vec::new(),
@@ -720,7 +642,7 @@ impl SceneDesc {
     /// references re-indexed to follow this description's own; its camera, film, integrator
     /// and sampler are dropped. How a scene composes a file of another format (a glTF file
     /// placed from JSON) as one group of shapes.
-    pub fn append_parts(&mut self, part: SceneDesc) {
+    pub fn append_parts(&mut self, part: SceneDesc<M>) {
         let (materials, meshes, media) = (self.materials.len(), self.meshes.len(), self.media.len());
         self.materials.extend(part.materials);
         self.meshes.extend(part.meshes);
@@ -744,90 +666,6 @@ impl SceneDesc {
     }
 }
 
-impl MaterialModel {
-    /// Every texture of the material, colours and roughness maps alike.
-    pub fn textures(&self) -> Vec<&TextureDesc> {
-        fn rough(r: &Option<Roughness>) -> Vec<&TextureDesc> {
-            r.as_ref().map_or(Vec::new(), Roughness::textures)
-        }
-        match self {
-            MaterialModel::Diffuse { reflectance } => vec![reflectance],
-            MaterialModel::Phong { kd, .. } => vec![kd],
-            MaterialModel::Plastic { diffuse, roughness, .. } => [vec![diffuse], rough(roughness)].concat(),
-            MaterialModel::Conductor { roughness, .. } | MaterialModel::Dielectric { roughness, .. } => {
-                rough(roughness)
-            }
-            MaterialModel::Black | MaterialModel::Null | MaterialModel::Hair(_) => vec![],
-            MaterialModel::PPlastic { diffuse, roughness, .. } => [vec![diffuse], roughness.textures()].concat(),
-            MaterialModel::NormalMap { normals: t, nested }
-            | MaterialModel::BumpMap { height: t, nested, .. }
-            | MaterialModel::Mask { opacity: t, nested } => {
-                let mut v = vec![t];
-                v.extend(nested.textures());
-                v
-            }
-            MaterialModel::Principled(p) => p.textures().into_iter().map(|(_, t)| t).collect(),
-            MaterialModel::Gltf(g) => g.textures(),
-            MaterialModel::Blend(b) => {
-                let mut v = vec![&b.weight];
-                v.extend(b.first.model.textures());
-                v.extend(b.second.model.textures());
-                v
-            }
-        }
-    }
-
-    pub fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
-        fn rough(r: &mut Option<Roughness>) -> Vec<&mut TextureDesc> {
-            r.as_mut().map_or(Vec::new(), Roughness::textures_mut)
-        }
-        match self {
-            MaterialModel::Diffuse { reflectance } => vec![reflectance],
-            MaterialModel::Phong { kd, .. } => vec![kd],
-            MaterialModel::Plastic { diffuse, roughness, .. } => {
-                let mut v = vec![diffuse];
-                v.extend(rough(roughness));
-                v
-            }
-            MaterialModel::Conductor { roughness, .. } | MaterialModel::Dielectric { roughness, .. } => {
-                rough(roughness)
-            }
-            MaterialModel::Black | MaterialModel::Null | MaterialModel::Hair(_) => vec![],
-            MaterialModel::NormalMap { normals: t, nested }
-            | MaterialModel::BumpMap { height: t, nested, .. }
-            | MaterialModel::Mask { opacity: t, nested } => {
-                let mut v = vec![t];
-                v.extend(nested.textures_mut());
-                v
-            }
-            MaterialModel::Principled(p) => p.textures_mut().into_iter().collect(),
-            MaterialModel::Gltf(g) => g.textures_mut(),
-            MaterialModel::Blend(b) => {
-                let mut v = vec![&mut b.weight];
-                v.extend(b.first.model.textures_mut());
-                v.extend(b.second.model.textures_mut());
-                v
-            }
-            MaterialModel::PPlastic { diffuse, roughness, .. } => {
-                let mut v = vec![diffuse];
-                v.extend(roughness.textures_mut());
-                v
-            }
-        }
-    }
-
-    /// The mesh attributes the material's textures read, with where each is named.
-    pub fn mesh_attributes(&self) -> Vec<(&str, &SourceLoc)> {
-        self.textures()
-            .into_iter()
-            .filter_map(|t| match t {
-                TextureDesc::MeshAttribute { name, loc, .. } => Some((name.as_str(), loc)),
-                _ => None,
-            })
-            .collect()
-    }
-}
-
 impl Default for CameraDesc {
     fn default() -> Self {
         CameraDesc {
@@ -848,6 +686,7 @@ impl Default for CameraDesc {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::materials::{DiffuseDesc, MaterialDesc, MaterialModel, SceneDesc};
 
     fn small_film(aovs: Vec<Aov>) -> FilmDesc {
         FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None, aovs }
@@ -884,7 +723,7 @@ mod tests {
         };
         d.materials.push(MaterialDesc {
             name: "wood".into(),
-            model: MaterialModel::Diffuse { reflectance: bitmap("wood.png") },
+            model: MaterialModel::Diffuse(DiffuseDesc { reflectance: bitmap("wood.png") }),
             two_sided: false,
             loc: SourceLoc::default(),
         });

@@ -6,14 +6,19 @@
 
 use super::json_spans::Spans;
 use crate::describe::{
-    Aov, CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
-    MaterialModel, MaterialRef, Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc,
-    ScalarTexture, SceneDesc, ShapeDesc, ShapeMedia, Strategy, TextureDesc, VolpathSettings, WhittedSettings,
+    Aov, CameraDesc, DirectSettings, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialRef,
+    Matrix4, MediumDesc, MeshFileDesc, PathSettings, PhaseDesc, Roughness, SamplerDesc, ScalarTexture, ShapeDesc,
+    ShapeMedia, Strategy, TextureDesc, VolpathSettings, WhittedSettings,
 };
-use crate::describe::{BlendDesc, BlendPartDesc, PrincipledDesc};
 use crate::describe::{CropWindow, FovAxis, LightSelection, MicrofacetKind, PixelFilter, Projection, SamplerKind};
 use crate::error::{Error, SourceLoc};
 use crate::materials::conductor_preset;
+use crate::materials::{
+    principled_eta_of_specular, BumpMapDesc, ConductorDesc, DielectricDesc, DiffuseDesc, MaskDesc, NormalMapDesc,
+    NullDesc, PPlasticDesc, PhongDesc, PlasticDesc,
+};
+use crate::materials::{BlendDesc, BlendPartDesc, PrincipledDesc};
+use crate::materials::{MaterialDesc, MaterialModel, SceneDesc};
 use crate::math::{Mat4, Rgb, Transform, Vec3};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -566,7 +571,7 @@ fn material_model_of(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Resul
     let at = at.to_string();
     let nested = |inner: &JsonMaterial| -> Result<(Box<MaterialModel>, bool), Error> {
         let (model, two_sided) = material_model_of(ctx, name, &format!("{at}/material"), inner)?;
-        if matches!(model, MaterialModel::NormalMap { .. } | MaterialModel::BumpMap { .. })
+        if matches!(model, MaterialModel::NormalMap(_) | MaterialModel::BumpMap(_))
             && !matches!(m, JsonMaterial::Mask { .. })
         {
             return Err(
@@ -579,18 +584,24 @@ fn material_model_of(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Resul
         JsonMaterial::NormalMap { normals, material } => {
             let (nested, two_sided) = nested(material)?;
             (
-                MaterialModel::NormalMap { normals: texture_of(ctx, &format!("{at}/normals"), normals), nested },
+                MaterialModel::NormalMap(NormalMapDesc {
+                    normals: texture_of(ctx, &format!("{at}/normals"), normals),
+                    nested,
+                }),
                 two_sided,
             )
         }
         JsonMaterial::BumpMap { height, scale, material } => {
             let (nested, two_sided) = nested(material)?;
             let height = texture_of(ctx, &format!("{at}/height"), height);
-            (MaterialModel::BumpMap { height, scale: scale.unwrap_or(1.0), nested }, two_sided)
+            (MaterialModel::BumpMap(BumpMapDesc { height, scale: scale.unwrap_or(1.0), nested }), two_sided)
         }
         JsonMaterial::Mask { opacity, material } => {
             let (nested, two_sided) = nested(material)?;
-            (MaterialModel::Mask { opacity: texture_of(ctx, &format!("{at}/opacity"), opacity), nested }, two_sided)
+            (
+                MaterialModel::Mask(MaskDesc { opacity: texture_of(ctx, &format!("{at}/opacity"), opacity), nested }),
+                two_sided,
+            )
         }
         _ => material_plain(ctx, name, &at, m)?,
     })
@@ -600,24 +611,26 @@ fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(
     let at = at.to_string();
     Ok(match m {
         JsonMaterial::Diffuse { reflectance, two_sided } => (
-            MaterialModel::Diffuse { reflectance: texture_of(ctx, &format!("{at}/reflectance"), reflectance) },
+            MaterialModel::Diffuse(DiffuseDesc {
+                reflectance: texture_of(ctx, &format!("{at}/reflectance"), reflectance),
+            }),
             two_sided.unwrap_or(true),
         ),
         JsonMaterial::Phong { kd, ks, exponent, two_sided } => (
-            MaterialModel::Phong {
+            MaterialModel::Phong(PhongDesc {
                 kd: texture_of(ctx, &format!("{at}/kd"), kd),
                 ks: ks.map_or(Rgb::BLACK, |c| c.rgb()),
                 exponent: exponent.unwrap_or(32.0),
-            },
+            }),
             two_sided.unwrap_or(true),
         ),
         JsonMaterial::Mirror { specular } => (
-            MaterialModel::Conductor {
+            MaterialModel::Conductor(ConductorDesc {
                 eta: Rgb::BLACK,
                 k: Rgb::WHITE,
                 specular: specular.map_or(Rgb::WHITE, |c| c.rgb()),
                 roughness: None,
-            },
+            }),
             true,
         ),
         JsonMaterial::Conductor { metal, eta, k, specular, alpha, alpha_v, distribution } => {
@@ -634,18 +647,24 @@ fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(
             };
             let specular = specular.map_or(Rgb::WHITE, |c| c.rgb());
             let roughness = roughness(ctx, &at, distribution, alpha, alpha_v)?;
-            (MaterialModel::Conductor { eta: e, k: kk, specular, roughness }, true)
+            (MaterialModel::Conductor(ConductorDesc { eta: e, k: kk, specular, roughness }), true)
         }
         JsonMaterial::Dielectric { ior, alpha, alpha_v, distribution, thin } => {
             let eta = ior.unwrap_or(1.5);
             let roughness = if *thin { None } else { roughness(ctx, &at, distribution, alpha, alpha_v)? };
             (
-                MaterialModel::Dielectric { eta, reflect: Rgb::WHITE, transmit: Rgb::WHITE, roughness, thin: *thin },
+                MaterialModel::Dielectric(DielectricDesc {
+                    eta,
+                    reflect: Rgb::WHITE,
+                    transmit: Rgb::WHITE,
+                    roughness,
+                    thin: *thin,
+                }),
                 false,
             )
         }
         JsonMaterial::Plastic { diffuse, ior, alpha, distribution, nonlinear } => (
-            MaterialModel::Plastic {
+            MaterialModel::Plastic(PlasticDesc {
                 diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
                 specular: Rgb::WHITE,
                 eta: ior.unwrap_or(1.49),
@@ -658,10 +677,10 @@ fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(
                     &None,
                 )?,
                 nonlinear: *nonlinear,
-            },
+            }),
             true,
         ),
-        JsonMaterial::Null {} => (MaterialModel::Null, false),
+        JsonMaterial::Null {} => (MaterialModel::Null(NullDesc {}), false),
         JsonMaterial::Pplastic { diffuse, specular, ior, alpha, alpha_v, distribution } => {
             // Mitsuba's defaults: Beckmann, alpha 0.1.
             let alpha = alpha.clone().or(Some(JsonTexture::Color(JsonColor::Grey(0.1))));
@@ -669,23 +688,23 @@ fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(
             let roughness = roughness(ctx, &at, &name, &alpha, alpha_v)?
                 .ok_or_else(|| ctx.err(&format!("{at}/alpha"), "pplastic needs a positive alpha"))?;
             (
-                MaterialModel::PPlastic {
+                MaterialModel::PPlastic(PPlasticDesc {
                     diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
                     specular: specular.map_or(Rgb::WHITE, |c| c.rgb()),
                     eta: ior.unwrap_or(1.49),
                     roughness,
-                },
+                }),
                 true,
             )
         }
         JsonMaterial::Polarizer { transmittance } => (
-            MaterialModel::Dielectric {
+            MaterialModel::Dielectric(DielectricDesc {
                 eta: 1.0,
                 reflect: Rgb::BLACK,
                 transmit: transmittance.map_or(Rgb::WHITE, |c| c.rgb()) * 0.5,
                 roughness: None,
                 thin: true,
-            },
+            }),
             false,
         ),
         JsonMaterial::Principled(p) => principled_of(ctx, &at, p)?,
@@ -712,7 +731,7 @@ fn principled_of(ctx: &Ctx, at: &str, p: &JsonPrincipled) -> Result<(MaterialMod
     let eta = match (p.ior, p.specular) {
         (Some(_), Some(_)) => return Err(ctx.err(at, "principled: give either 'ior' or 'specular', not both")),
         (Some(ior), None) => ior,
-        (None, Some(s)) => crate::describe::principled_eta_of_specular(s),
+        (None, Some(s)) => principled_eta_of_specular(s),
         (None, None) => d.eta,
     };
     let desc = PrincipledDesc {

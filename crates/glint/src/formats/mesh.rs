@@ -2,10 +2,13 @@
 //! a camera that frames it from the front (for `glint info mesh.obj` and quick previews).
 
 use crate::describe::{
-    CameraDesc, FilmDesc, FovAxis, Geometry, LightDesc, LightKind, MaterialDesc, MaterialModel, MaterialRef,
-    PixelFilter, SceneDesc, ShapeDesc, TextureDesc, IDENTITY,
+    CameraDesc, FilmDesc, FovAxis, Geometry, LightDesc, LightKind, MaterialRef, PixelFilter, ShapeDesc, TextureDesc,
+    IDENTITY,
 };
+use crate::materials::DiffuseDesc;
+
 use crate::error::{Error, SourceLoc};
+use crate::materials::{MaterialDesc, MaterialModel, SceneDesc};
 use crate::math::{Rgb, Vec3};
 use std::path::Path;
 
@@ -22,7 +25,7 @@ pub fn describe(path: &Path) -> Result<SceneDesc, Error> {
     d.source = Some(path.to_path_buf());
     d.materials.push(MaterialDesc {
         name: "grey".into(),
-        model: MaterialModel::Diffuse { reflectance: TextureDesc::constant(Rgb::splat(0.6)) },
+        model: MaterialModel::Diffuse(DiffuseDesc { reflectance: TextureDesc::constant(Rgb::splat(0.6)) }),
         two_sided: true,
         loc: loc.clone(),
     });

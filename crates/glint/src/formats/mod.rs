@@ -8,8 +8,8 @@ mod json_spans;
 pub mod mesh;
 pub mod mitsuba;
 
-use crate::describe::SceneDesc;
 use crate::error::{Error, SourceLoc};
+use crate::materials::SceneDesc;
 use std::path::Path;
 
 /// A `-D name=value` override of a Mitsuba `<default>`.

@@ -275,12 +275,17 @@ mod tests {
         ));
         let mirror = b.add_material(Material::new(
             "mirror",
-            MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::splat(0.9) }),
+            MaterialKind::Conductor(ConductorMaterial {
+                eta: Rgb::BLACK,
+                k: Rgb::WHITE,
+                specular: Rgb::splat(0.9),
+                roughness: None,
+            }),
             true,
         ));
         let glass = b.add_material(Material::new(
             "glass",
-            MaterialKind::Dielectric(DielectricMaterial { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE }),
+            MaterialKind::Dielectric(DielectricMaterial::smooth(1.5, Rgb::WHITE, Rgb::WHITE)),
             false,
         ));
         let quad = |b: &mut WorldBuilder, p: [Vec3; 4], m: u32, e: Option<AreaEmission>| {
@@ -431,7 +436,12 @@ mod tests {
         let mut b = WorldBuilder::new(BvhSplit::Sah);
         let mirror = b.add_material(Material::new(
             "mirror",
-            MaterialKind::Conductor(ConductorMaterial { eta: Rgb::BLACK, k: Rgb::WHITE, specular: Rgb::WHITE }),
+            MaterialKind::Conductor(ConductorMaterial {
+                eta: Rgb::BLACK,
+                k: Rgb::WHITE,
+                specular: Rgb::WHITE,
+                roughness: None,
+            }),
             true,
         ));
         for z in [-1.0f32, 1.0] {

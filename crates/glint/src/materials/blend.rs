@@ -17,10 +17,12 @@
 //! allocates); every other BSDF stays inline.
 
 use super::{Bsdf, MaterialKind, ScalarTexture, Shade, TextureCache, TexturePoint};
+use super::{Describe, MaterialModel};
 use crate::bsdf::{BsdfSample, Scatter};
-use crate::describe::{BlendDesc, BlendPartDesc};
+use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::math::{Rgb, Vec3};
+use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug)]
 pub struct BlendPart {
@@ -154,6 +156,54 @@ impl Scatter for BlendBsdf {
     }
 }
 
+/// One of a blend's two materials, with its own sidedness (a `twosided` inside the blend).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlendPartDesc {
+    pub model: MaterialModel,
+    pub two_sided: bool,
+}
+
+/// `blendbsdf`'s parameters: (1 - `weight`) · `first` + `weight` · `second`.
+///
+/// | Parameter | Type | Default (JSON, Mitsuba) | |
+/// |---|---|---|---|
+/// | `weight` | texture | (Mitsuba 0.5) | read as a grey value (its luminance) |
+/// | `first`, `second` | material | (required) | each with its own sidedness |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlendDesc {
+    pub weight: TextureDesc,
+    pub first: Box<BlendPartDesc>,
+    pub second: Box<BlendPartDesc>,
+}
+
+impl Describe for BlendDesc {
+    type Built = BlendMaterial;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<BlendMaterial, Error> {
+        let mut part = |p: &BlendPartDesc| -> Result<BlendMaterialPart, Error> {
+            Ok(BlendMaterialPart { kind: p.model.build(textures)?, two_sided: p.two_sided })
+        };
+        let (first, second) = (part(&self.first)?, part(&self.second)?);
+        Ok(BlendMaterial::new(ScalarTexture::new(textures.texture(&self.weight)?), first, second))
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        // Each part is checked as a material of its own (its textures included).
+        self.first.model.validate().map_err(|e| format!("blend, first part: {e}"))?;
+        self.second.model.validate().map_err(|e| format!("blend, second part: {e}"))
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        let parts = [&self.first, &self.second].into_iter().flat_map(|p| p.model.textures());
+        std::iter::once(&self.weight).chain(parts).collect()
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        let parts = [&mut self.first, &mut self.second].into_iter().flat_map(|p| p.model.textures_mut());
+        std::iter::once(&mut self.weight).chain(parts).collect()
+    }
+}
+
 /// One part of a blend: a material kind and whether it alone is two-sided.
 #[derive(Clone, Debug)]
 pub struct BlendMaterialPart {
@@ -170,14 +220,6 @@ pub struct BlendMaterial {
 impl BlendMaterial {
     pub fn new(weight: ScalarTexture, first: BlendMaterialPart, second: BlendMaterialPart) -> BlendMaterial {
         BlendMaterial { weight, parts: Box::new([first, second]) }
-    }
-
-    pub(crate) fn build(b: &BlendDesc, textures: &mut TextureCache) -> Result<BlendMaterial, Error> {
-        let mut part = |p: &BlendPartDesc| -> Result<BlendMaterialPart, Error> {
-            Ok(BlendMaterialPart { kind: MaterialKind::build(&p.model, textures)?, two_sided: p.two_sided })
-        };
-        let (first, second) = (part(&b.first)?, part(&b.second)?);
-        Ok(BlendMaterial::new(ScalarTexture::new(textures.texture(&b.weight)?), first, second))
     }
 
     pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {

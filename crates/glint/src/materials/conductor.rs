@@ -6,11 +6,12 @@
 //! Metals (Mitsuba's `conductor` and `roughconductor`): Fresnel reflection with a complex
 //! index of refraction per channel, off a perfect mirror or a microfacet surface.
 
-use super::{roughness_map, Bsdf, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
+use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_conductor, reflect_local, BsdfSample, Microfacet, Scatter};
-use crate::describe::Roughness;
+use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3};
+use serde::{Deserialize, Serialize};
 
 /// Perfectly smooth metal.
 #[derive(Clone, Copy, Debug)]
@@ -110,65 +111,62 @@ impl Scatter for RoughConductor {
     }
 }
 
+/// `conductor`'s and `roughconductor`'s parameters.
+///
+/// | Parameter | Type | Default (JSON, Mitsuba) | |
+/// |---|---|---|---|
+/// | `eta`, `k` | colour | a perfect mirror (0, 1); JSON `metal` and Mitsuba `material` name presets | complex index of refraction |
+/// | `specular` | colour | 1 | tint (Mitsuba's `specular_reflectance`) |
+/// | `roughness` | roughness | none: smooth | distribution and (textured) `alpha`, `alpha_v` |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ConductorDesc {
+    pub eta: Rgb,
+    pub k: Rgb,
+    pub specular: Rgb,
+    pub roughness: Option<Roughness>,
+}
+
+impl Describe for ConductorDesc {
+    type Built = ConductorMaterial;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<ConductorMaterial, Error> {
+        let roughness = self.roughness.as_ref().map(|r| roughness_map(r, textures)).transpose()?;
+        Ok(ConductorMaterial { eta: self.eta, k: self.k, specular: self.specular, roughness })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        checks::color(self.eta, "eta")?;
+        checks::color(self.k, "k")?;
+        checks::color(self.specular, "specular reflectance")?;
+        checks::roughness(self.roughness.as_ref())
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        self.roughness.as_ref().map_or(Vec::new(), Roughness::textures)
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        self.roughness.as_mut().map_or(Vec::new(), Roughness::textures_mut)
+    }
+}
+
+/// A smooth metal, or a rough one where `roughness` is given.
 #[derive(Clone, Debug)]
 pub struct ConductorMaterial {
     pub eta: Rgb,
     pub k: Rgb,
     pub specular: Rgb,
-}
-
-#[derive(Clone, Debug)]
-pub struct RoughConductorMaterial {
-    pub dist: RoughnessMap,
-    pub eta: Rgb,
-    pub k: Rgb,
-    pub specular: Rgb,
-}
-
-/// The smooth or rough conductor a description gives.
-pub(crate) fn build(
-    eta: Rgb,
-    k: Rgb,
-    specular: Rgb,
-    roughness: Option<&Roughness>,
-    textures: &mut TextureCache,
-) -> Result<MaterialKind, Error> {
-    Ok(match roughness {
-        None => MaterialKind::Conductor(ConductorMaterial { eta, k, specular }),
-        Some(r) => {
-            MaterialKind::RoughConductor(RoughConductorMaterial { dist: roughness_map(r, textures)?, eta, k, specular })
-        }
-    })
+    pub roughness: Option<RoughnessMap>,
 }
 
 impl Shade for ConductorMaterial {
     #[inline]
-    fn bsdf_at(&self, _p: &TexturePoint) -> Bsdf {
-        Bsdf::Conductor(Conductor { eta: self.eta, k: self.k, specular: self.specular })
-    }
-
-    fn albedo(&self, _uv: [f32; 2]) -> Rgb {
-        self.specular
-    }
-
-    fn is_transmissive(&self) -> bool {
-        false
-    }
-
-    fn nested(&self) -> Option<&MaterialKind> {
-        None
-    }
-}
-
-impl Shade for RoughConductorMaterial {
-    #[inline]
     fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
-        Bsdf::RoughConductor(RoughConductor {
-            dist: self.dist.at(p.uv),
-            eta: self.eta,
-            k: self.k,
-            specular: self.specular,
-        })
+        let (eta, k, specular) = (self.eta, self.k, self.specular);
+        match &self.roughness {
+            None => Bsdf::Conductor(Conductor { eta, k, specular }),
+            Some(dist) => Bsdf::RoughConductor(RoughConductor { dist: dist.at(p.uv), eta, k, specular }),
+        }
     }
 
     fn albedo(&self, _uv: [f32; 2]) -> Rgb {

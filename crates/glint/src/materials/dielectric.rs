@@ -7,12 +7,13 @@
 //! Glass (Mitsuba's `dielectric`, `roughdielectric` and `thindielectric`): `eta` is
 //! n_inside / n_outside; `reflect` and `transmit` tint the two directions.
 
-use super::{roughness_map, Bsdf, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
+use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{eval_rough_dielectric, pdf_rough_dielectric, sample_rough_dielectric};
 use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, BsdfSample, Microfacet, Scatter};
-use crate::describe::Roughness;
+use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3};
+use serde::{Deserialize, Serialize};
 
 /// Smooth glass: one reflected and one refracted direction.
 #[derive(Clone, Copy, Debug)]
@@ -145,96 +146,86 @@ impl Scatter for ThinDielectric {
     }
 }
 
+/// `dielectric`'s, `roughdielectric`'s and `thindielectric`'s parameters.
+///
+/// | Parameter | Type | Default (JSON, Mitsuba) | |
+/// |---|---|---|---|
+/// | `eta` | float | 1.5 (JSON `ior`; Mitsuba `int_ior` / `ext_ior`) | interior over exterior index |
+/// | `reflect`, `transmit` | colour | 1 | tints (Mitsuba's `specular_reflectance`, `specular_transmittance`) |
+/// | `roughness` | roughness | none: smooth | distribution and (textured) `alpha`, `alpha_v` |
+/// | `thin` | bool | false | an infinitely thin slab (always smooth) |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DielectricDesc {
+    pub eta: f32,
+    pub reflect: Rgb,
+    pub transmit: Rgb,
+    pub roughness: Option<Roughness>,
+    pub thin: bool,
+}
+
+impl Describe for DielectricDesc {
+    type Built = DielectricMaterial;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<DielectricMaterial, Error> {
+        let surface = match (self.thin, &self.roughness) {
+            (true, _) => DielectricSurface::Thin,
+            (false, None) => DielectricSurface::Smooth,
+            (false, Some(r)) => DielectricSurface::Rough(roughness_map(r, textures)?),
+        };
+        Ok(DielectricMaterial { eta: self.eta, reflect: self.reflect, transmit: self.transmit, surface })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        checks::eta(self.eta)?;
+        checks::color(self.reflect, "specular reflectance")?;
+        checks::color(self.transmit, "specular transmittance")?;
+        checks::roughness(self.roughness.as_ref())
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        self.roughness.as_ref().map_or(Vec::new(), Roughness::textures)
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        self.roughness.as_mut().map_or(Vec::new(), Roughness::textures_mut)
+    }
+}
+
+/// Which dielectric interface a material has.
+#[derive(Clone, Debug)]
+pub enum DielectricSurface {
+    Smooth,
+    Rough(RoughnessMap),
+    /// An infinitely thin slab.
+    Thin,
+}
+
 #[derive(Clone, Debug)]
 pub struct DielectricMaterial {
     pub eta: f32,
     pub reflect: Rgb,
     pub transmit: Rgb,
+    pub surface: DielectricSurface,
 }
 
-#[derive(Clone, Debug)]
-pub struct RoughDielectricMaterial {
-    pub dist: RoughnessMap,
-    pub eta: f32,
-    pub reflect: Rgb,
-    pub transmit: Rgb,
-}
-
-#[derive(Clone, Debug)]
-pub struct ThinDielectricMaterial {
-    pub eta: f32,
-    pub reflect: Rgb,
-    pub transmit: Rgb,
-}
-
-/// The smooth, rough or thin dielectric a description gives (a thin one is always smooth).
-pub(crate) fn build(
-    eta: f32,
-    reflect: Rgb,
-    transmit: Rgb,
-    roughness: Option<&Roughness>,
-    thin: bool,
-    textures: &mut TextureCache,
-) -> Result<MaterialKind, Error> {
-    Ok(match (thin, roughness) {
-        (true, _) => MaterialKind::ThinDielectric(ThinDielectricMaterial { eta, reflect, transmit }),
-        (false, None) => MaterialKind::Dielectric(DielectricMaterial { eta, reflect, transmit }),
-        (false, Some(r)) => MaterialKind::RoughDielectric(RoughDielectricMaterial {
-            dist: roughness_map(r, textures)?,
-            eta,
-            reflect,
-            transmit,
-        }),
-    })
+impl DielectricMaterial {
+    /// Smooth glass.
+    pub fn smooth(eta: f32, reflect: Rgb, transmit: Rgb) -> DielectricMaterial {
+        DielectricMaterial { eta, reflect, transmit, surface: DielectricSurface::Smooth }
+    }
 }
 
 impl Shade for DielectricMaterial {
     #[inline]
-    fn bsdf_at(&self, _p: &TexturePoint) -> Bsdf {
-        Bsdf::Dielectric(Dielectric { eta: self.eta, reflect: self.reflect, transmit: self.transmit })
-    }
-
-    fn albedo(&self, _uv: [f32; 2]) -> Rgb {
-        self.transmit
-    }
-
-    fn is_transmissive(&self) -> bool {
-        true
-    }
-
-    fn nested(&self) -> Option<&MaterialKind> {
-        None
-    }
-}
-
-impl Shade for RoughDielectricMaterial {
-    #[inline]
     fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
-        Bsdf::RoughDielectric(RoughDielectric {
-            dist: self.dist.at(p.uv),
-            eta: self.eta,
-            reflect: self.reflect,
-            transmit: self.transmit,
-        })
-    }
-
-    fn albedo(&self, _uv: [f32; 2]) -> Rgb {
-        self.transmit
-    }
-
-    fn is_transmissive(&self) -> bool {
-        true
-    }
-
-    fn nested(&self) -> Option<&MaterialKind> {
-        None
-    }
-}
-
-impl Shade for ThinDielectricMaterial {
-    #[inline]
-    fn bsdf_at(&self, _p: &TexturePoint) -> Bsdf {
-        Bsdf::ThinDielectric(ThinDielectric { eta: self.eta, reflect: self.reflect, transmit: self.transmit })
+        let (eta, reflect, transmit) = (self.eta, self.reflect, self.transmit);
+        match &self.surface {
+            DielectricSurface::Smooth => Bsdf::Dielectric(Dielectric { eta, reflect, transmit }),
+            DielectricSurface::Rough(dist) => {
+                Bsdf::RoughDielectric(RoughDielectric { dist: dist.at(p.uv), eta, reflect, transmit })
+            }
+            DielectricSurface::Thin => Bsdf::ThinDielectric(ThinDielectric { eta, reflect, transmit }),
+        }
     }
 
     fn albedo(&self, _uv: [f32; 2]) -> Rgb {

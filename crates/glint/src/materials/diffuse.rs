@@ -3,12 +3,13 @@
 //! # The BSDF
 //! Lambertian reflection (Mitsuba's `diffuse`).
 
-use super::{Bsdf, Shade, Texture, TextureCache, TexturePoint};
+use super::{Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{BsdfSample, Scatter};
 use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
+use serde::{Deserialize, Serialize};
 
 /// Reflects `reflectance` of the light, evenly in every direction of the upper hemisphere.
 #[derive(Clone, Copy, Debug)]
@@ -62,15 +63,39 @@ impl Scatter for Diffuse {
     }
 }
 
+/// `diffuse`'s parameters.
+///
+/// | Parameter | Type | Default (JSON, Mitsuba) | |
+/// |---|---|---|---|
+/// | `reflectance` | texture | 0.5 | the albedo |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiffuseDesc {
+    pub reflectance: TextureDesc,
+}
+
+impl Describe for DiffuseDesc {
+    type Built = DiffuseMaterial;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<DiffuseMaterial, Error> {
+        Ok(DiffuseMaterial { reflectance: textures.texture(&self.reflectance)? })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        vec![&self.reflectance]
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        vec![&mut self.reflectance]
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct DiffuseMaterial {
     pub reflectance: Texture,
-}
-
-impl DiffuseMaterial {
-    pub(crate) fn build(reflectance: &TextureDesc, textures: &mut TextureCache) -> Result<DiffuseMaterial, Error> {
-        Ok(DiffuseMaterial { reflectance: textures.texture(reflectance)? })
-    }
 }
 
 impl Shade for DiffuseMaterial {
@@ -87,7 +112,7 @@ impl Shade for DiffuseMaterial {
         false
     }
 
-    fn nested(&self) -> Option<&super::MaterialKind> {
+    fn nested(&self) -> Option<&MaterialKind> {
         None
     }
 }

@@ -15,10 +15,12 @@
 //! path through the fibre) and an azimuthal lobe N_p (a trimmed logistic around the
 //! specular Δφ). At zero absorption the A_p sum to 1 and each M_p N_p to 1: energy is kept.
 
-use super::{Bsdf, MaterialKind, Shade, TexturePoint};
+use super::{Bsdf, Describe, MaterialKind, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, BsdfSample, Scatter};
-use crate::describe::HairDesc;
+use crate::describe::{checks, TextureDesc};
+use crate::error::Error;
 use crate::math::{Rgb, Vec3, PI};
+use serde::{Deserialize, Serialize};
 
 /// Terms modelled separately; the rest are summed into one.
 const P_MAX: usize = 3;
@@ -321,8 +323,64 @@ impl Scatter for HairBsdf {
     }
 }
 
-pub(crate) fn build(h: &HairDesc) -> HairBsdf {
-    HairBsdf::new(h.sigma_a, h.eta, h.longitudinal_roughness, h.azimuthal_roughness, h.scale_tilt)
+/// `hair`'s parameters (Mitsuba's, with the pigments or `sigma_a` times `scale` folded into
+/// `sigma_a` by the reader).
+///
+/// | Parameter | Type | Default (Mitsuba) | |
+/// |---|---|---|---|
+/// | `sigma_a` | colour | from eumelanin 1.3, pheomelanin 0 | absorption per fibre radius |
+/// | `eta` | float | 1.55 | interior over exterior index |
+/// | `longitudinal_roughness` | float | 0.3 | in [0, 1] |
+/// | `azimuthal_roughness` | float | 0.3 | in [0, 1] |
+/// | `scale_tilt` | float | 2 | degrees |
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HairDesc {
+    pub sigma_a: Rgb,
+    pub eta: f32,
+    pub longitudinal_roughness: f32,
+    pub azimuthal_roughness: f32,
+    pub scale_tilt: f32,
+}
+
+impl Describe for HairDesc {
+    type Built = HairBsdf;
+
+    fn build(&self, _textures: &mut TextureCache) -> Result<HairBsdf, Error> {
+        Ok(HairBsdf::new(
+            self.sigma_a,
+            self.eta,
+            self.longitudinal_roughness,
+            self.azimuthal_roughness,
+            self.scale_tilt,
+        ))
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        checks::eta(self.eta)?;
+        let s = self.sigma_a;
+        if !(s.r >= 0.0 && s.g >= 0.0 && s.b >= 0.0 && s.max_component().is_finite()) {
+            return Err(format!("hair absorption {s:?} must be finite and not negative"));
+        }
+        for (name, v) in
+            [("longitudinal_roughness", self.longitudinal_roughness), ("azimuthal_roughness", self.azimuthal_roughness)]
+        {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(format!("hair {name} {v} must be in [0, 1]"));
+            }
+        }
+        if !self.scale_tilt.is_finite() {
+            return Err(format!("hair scale_tilt {} must be finite", self.scale_tilt));
+        }
+        Ok(())
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        Vec::new()
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        Vec::new()
+    }
 }
 
 impl Shade for HairBsdf {

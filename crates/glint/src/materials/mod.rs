@@ -1,15 +1,20 @@
-//! Materials: what a surface is made of, with textured parameters. `Material::bsdf`
-//! evaluates the textures at a hit point and returns the [`Bsdf`] to scatter with.
+//! Materials: what a surface is made of. `Material::bsdf` evaluates the textures at a hit
+//! point and returns the [`Bsdf`] to scatter with.
 //!
 //! # Adding a material
-//! A material is one module here: its built form (textures made, constants folded) with an
-//! `impl Shade` (the BSDF at a hit point, the denoiser's albedo, whether it transmits, the
-//! material it wraps: none has a default, so the compiler names any the new type lacks) and
-//! the `build` that makes it from its description; and one line in the `materials!` list
-//! below, which makes the [`MaterialKind`] variant, its static dispatch and its `From`
-//! conversion. Its BSDF (an `impl Scatter`, see `bsdf`) lives in the same module, with one
-//! line in the `bsdfs!` list, which makes the [`Bsdf`] variant the same way.
-//! docs/rendering.md ("Adding a material") lists what else a material touches.
+//! A material is one module here (`diffuse.rs`, `conductor.rs`, ...; a folder where it is
+//! long, as `principled/`), holding, with its parameters listed in its documentation:
+//! - its description (serde, the `type` a JSON scene names) with an `impl Describe`: how it
+//!   builds, the check of its numbers, the textures it reads;
+//! - its built form (textures made, constants folded) with an `impl Shade`: the BSDF at a hit
+//!   point, the denoiser's albedo, whether it transmits, the material it wraps;
+//! - its BSDF with an `impl Scatter` (see `bsdf`): eval, pdf, sample.
+//!
+//! None of the three traits has a default method, so the compiler names any the new type
+//! lacks. One line in the `materials!` list below then makes the [`MaterialModel`],
+//! [`MaterialKind`] and [`Bsdf`] variants, their static dispatch and their `From`
+//! conversions; each scene format reads it with one function of its reader.
+//! docs/rendering.md ("Adding a material") walks through it.
 
 mod blend;
 mod conductor;
@@ -28,126 +33,60 @@ mod roughness;
 mod surface;
 mod texture;
 mod texture_cache;
-pub use blend::{BlendBsdf, BlendMaterial, BlendMaterialPart, BlendPart};
-pub use conductor::{Conductor, ConductorMaterial, RoughConductor, RoughConductorMaterial};
+pub use blend::{BlendBsdf, BlendDesc, BlendMaterial, BlendMaterialPart, BlendPart, BlendPartDesc};
+pub use conductor::{Conductor, ConductorDesc, ConductorMaterial, RoughConductor};
 pub use dielectric::{
-    Dielectric, DielectricMaterial, RoughDielectric, RoughDielectricMaterial, ThinDielectric, ThinDielectricMaterial,
+    Dielectric, DielectricDesc, DielectricMaterial, DielectricSurface, RoughDielectric, ThinDielectric,
 };
-pub use diffuse::{Diffuse, DiffuseMaterial};
+pub use diffuse::{Diffuse, DiffuseDesc, DiffuseMaterial};
 pub use gltf::{
-    sheen_albedo, sheen_albedo_quadrature, GltfAlpha, GltfExtensionTextures, GltfMaterial, GltfPbr, GltfTexture,
-    ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, SHEEN_ALBEDO_TOLERANCE, SHEEN_MIN_ROUGHNESS, TANGENT_ATTRIBUTE,
-    TANGENT_SIGN_ATTRIBUTE, UV1_ATTRIBUTE,
+    sheen_albedo, sheen_albedo_quadrature, GltfAlpha, GltfAlphaMode, GltfExtensionTextures, GltfMaterial,
+    GltfMaterialDesc, GltfPbr, GltfTexture, ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, SHEEN_ALBEDO_TOLERANCE,
+    SHEEN_MIN_ROUGHNESS, TANGENT_ATTRIBUTE, TANGENT_SIGN_ATTRIBUTE, UV1_ATTRIBUTE,
 };
-pub use hair::{HairBsdf, EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
-pub use passthrough::{Black, Null};
+pub use hair::{HairBsdf, HairDesc, EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
+pub use passthrough::{Black, BlackDesc, Null, NullDesc};
 pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
-pub use phong::{Phong, PhongMaterial};
-pub use plastic::{PlasticMaterial, PlasticParams};
-pub use pplastic::{PPlasticMaterial, PPlasticParams};
-pub use principled::{principled_alphas, AnisoGgx, Principled, PrincipledInputs, PrincipledMaterial, PrincipledRates};
+pub use phong::{Phong, PhongDesc, PhongMaterial};
+pub use plastic::{PlasticDesc, PlasticMaterial, PlasticParams};
+pub use pplastic::{PPlasticDesc, PPlasticMaterial, PPlasticParams};
+pub use principled::{
+    principled_alphas, principled_eta_of_specular, AnisoGgx, Principled, PrincipledDesc, PrincipledInputs,
+    PrincipledMaterial, PrincipledRates,
+};
 pub use roughness::RoughnessMap;
 pub(crate) use roughness::{constant_microfacet, roughness_map};
-pub use surface::{BumpMapMaterial, MaskMaterial, NormalMapMaterial, Perturbation};
+pub use surface::{
+    BumpMapDesc, BumpMapMaterial, MaskDesc, MaskMaterial, NormalMapDesc, NormalMapMaterial, Perturbation,
+};
 pub use texture::{Bitmap, ScalarTexture, Texture, TexturePoint};
 pub use texture_cache::TextureCache;
 
 use crate::bsdf::{BsdfSample, Scatter};
-use crate::describe::MaterialModel;
-use crate::error::Error;
+use crate::describe::{self, checks, TextureDesc};
+use crate::error::{Error, SourceLoc};
 use crate::math::{Rgb, Vec3};
+use serde::{Deserialize, Serialize};
 
-/// Makes the closed [`Bsdf`] enum from one list of `Variant(Type)`, each type a
-/// [`Scatter`]: the enum, its static dispatch of every `Scatter` method (one arm per
-/// variant, no wildcard) and `From<Type> for Bsdf`.
-macro_rules! bsdfs {
-    ($($(#[doc = $doc:literal])* $variant:ident($ty:ty),)+) => {
-        /// Not `Copy`: a blend owns its two parts (see `blend.rs`); every other variant is
-        /// plain data.
-        #[derive(Clone, Debug)]
-        pub enum Bsdf {
-            $($(#[doc = $doc])* $variant($ty),)+
-        }
+/// What every material description answers: how it builds, whether its numbers are in
+/// range, which textures it reads. No method has a default.
+pub trait Describe {
+    /// What it builds into (a [`MaterialKind`] variant's type, or a `MaterialKind` for a
+    /// description that builds wrappers around its material, as glTF's does).
+    type Built: Into<MaterialKind>;
 
-        // Inherent, so that callers of a `Bsdf` need not import `Scatter`.
-        impl Bsdf {
-            /// See [`Scatter::is_delta`].
-            pub fn is_delta(&self) -> bool {
-                match self { $(Bsdf::$variant(b) => b.is_delta(),)+ }
-            }
+    /// The built material, its textures made (or found in `textures`).
+    fn build(&self, textures: &mut TextureCache) -> Result<Self::Built, Error>;
 
-            /// See [`Scatter::has_delta_lobe`].
-            pub fn has_delta_lobe(&self) -> bool {
-                match self { $(Bsdf::$variant(b) => b.has_delta_lobe(),)+ }
-            }
+    /// Checks the parameters' numbers (textures are checked by the caller); the message
+    /// names the parameter.
+    fn validate(&self) -> Result<(), String>;
 
-            /// See [`Scatter::eval`].
-            pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-                match self { $(Bsdf::$variant(b) => b.eval(wo, wi),)+ }
-            }
+    /// Every texture, colours and roughness maps alike, nested materials' included, in a
+    /// fixed order.
+    fn textures(&self) -> Vec<&TextureDesc>;
 
-            /// See [`Scatter::pdf`].
-            pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-                match self { $(Bsdf::$variant(b) => b.pdf(wo, wi),)+ }
-            }
-
-            /// See [`Scatter::sample`].
-            pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
-                match self { $(Bsdf::$variant(b) => b.sample(wo, u_lobe, u),)+ }
-            }
-
-            /// See [`Scatter::diffuse_reflectance`].
-            pub fn diffuse_reflectance(&self) -> Rgb {
-                match self { $(Bsdf::$variant(b) => b.diffuse_reflectance(),)+ }
-            }
-
-            /// See [`Scatter::passage_transmission`].
-            pub fn passage_transmission(&self, wo: Vec3) -> Option<Rgb> {
-                match self { $(Bsdf::$variant(b) => b.passage_transmission(wo),)+ }
-            }
-        }
-
-        $(impl From<$ty> for Bsdf {
-            fn from(b: $ty) -> Bsdf {
-                Bsdf::$variant(b)
-            }
-        })+
-    };
-}
-
-bsdfs! {
-    /// Lambertian reflection.
-    Diffuse(Diffuse),
-    /// Diffuse plus a normalised Phong lobe (the Whitted integrator's glossy term).
-    Phong(Phong),
-    /// Perfectly smooth metal with complex index of refraction per channel.
-    Conductor(Conductor),
-    /// Microfacet metal (GGX or Beckmann).
-    RoughConductor(RoughConductor),
-    /// Smooth glass: `eta` is n_inside / n_outside.
-    Dielectric(Dielectric),
-    /// Rough glass with a microfacet interface.
-    RoughDielectric(RoughDielectric),
-    /// An infinitely thin slab of glass: reflection and straight-through transmission with
-    /// the inter-reflections summed (Mitsuba's `thindielectric`).
-    ThinDielectric(ThinDielectric),
-    /// Diffuse base under a smooth or rough dielectric coating (Mitsuba's `plastic` and
-    /// `roughplastic`), with the internal-scattering correction of the diffuse term.
-    Plastic(PlasticParams),
-    /// Absorbs everything (light sources with no material).
-    Black(Black),
-    /// Passes light straight through, unchanged (Mitsuba's `null`): a medium's boundary.
-    Null(Null),
-    /// Mitsuba's `principled` (Disney) BSDF.
-    Principled(Principled),
-    /// Mitsuba's `blendbsdf`: a weighted mixture of two BSDFs.
-    Blend(BlendBsdf),
-    /// Mitsuba's `pplastic` as its unpolarized variants render it.
-    PPlastic(PPlasticParams),
-    /// Mitsuba's `hair` (Chiang et al. 2016), in a curve's frame (x around, y along).
-    Hair(HairBsdf),
-    /// The glTF 2.0 metallic-roughness BRDF with the KHR material extensions.
-    GltfPbr(GltfPbr),
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc>;
 }
 
 /// What every built material answers. No method has a default, so that a new material
@@ -168,16 +107,63 @@ pub trait Shade {
     fn nested(&self) -> Option<&MaterialKind>;
 }
 
-/// Makes the closed [`MaterialKind`] enum from one list of `Variant(Type)`, each type a
-/// [`Shade`]: the enum, its static dispatch of every `Shade` method (one arm per variant, no
-/// wildcard) and `From<Type> for MaterialKind`.
+/// Makes the three closed sets of materials from one list of
+/// `Variant(Description => Built) [BsdfVariant(BsdfType), ...]`, a line per material:
+/// - [`MaterialModel`], the descriptions (serde, tagged by `type`: the variant's name in
+///   lower case), with the [`Describe`] dispatch;
+/// - [`MaterialKind`], the built materials, with the [`Shade`] dispatch;
+/// - [`Bsdf`], every material's BSDFs, with the [`Scatter`] dispatch;
+///
+/// each dispatch one arm per variant, no wildcard, and the `From` conversions into each enum.
 macro_rules! materials {
-    ($($(#[doc = $doc:literal])* $variant:ident($ty:ty),)+) => {
+    ($($(#[doc = $doc:literal])* $variant:ident($desc:ty => $kind:ty) [$($bvariant:ident($bty:ty)),*],)+) => {
+        /// A material as a scene describes it.
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(tag = "type", rename_all = "lowercase")]
+        // Kept unboxed: a description is built once and read once.
+        #[allow(clippy::large_enum_variant)]
+        pub enum MaterialModel {
+            $($(#[doc = $doc])* $variant($desc),)+
+        }
+
+        impl MaterialModel {
+            /// The built material (see [`Describe::build`]).
+            pub fn build(&self, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
+                match self { $(MaterialModel::$variant(d) => Ok(Describe::build(d, textures)?.into()),)+ }
+            }
+
+            /// Checks every texture as a colour, then the parameters (see
+            /// [`Describe::validate`]).
+            pub fn validate(&self) -> Result<(), String> {
+                for t in self.textures() {
+                    checks::texture(t, "colour")?;
+                }
+                match self { $(MaterialModel::$variant(d) => Describe::validate(d),)+ }
+            }
+
+            /// See [`Describe::textures`].
+            pub fn textures(&self) -> Vec<&TextureDesc> {
+                match self { $(MaterialModel::$variant(d) => Describe::textures(d),)+ }
+            }
+
+            /// See [`Describe::textures_mut`].
+            pub fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+                match self { $(MaterialModel::$variant(d) => Describe::textures_mut(d),)+ }
+            }
+        }
+
+        $(impl From<$desc> for MaterialModel {
+            fn from(d: $desc) -> MaterialModel {
+                MaterialModel::$variant(d)
+            }
+        })+
+
+        /// A material built: textures made, constants folded.
         // Unboxed on purpose: materials are read at every hit, and a box is a pointer chase.
         #[allow(clippy::large_enum_variant)]
         #[derive(Clone, Debug)]
         pub enum MaterialKind {
-            $($(#[doc = $doc])* $variant($ty),)+
+            $($(#[doc = $doc])* $variant($kind),)+
         }
 
         // Inherent, so that callers need not import `Shade`.
@@ -185,105 +171,153 @@ macro_rules! materials {
             /// This kind's own BSDF at a hit point (see [`Shade::bsdf_at`]).
             #[inline]
             pub fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
-                match self { $(MaterialKind::$variant(m) => m.bsdf_at(p),)+ }
+                match self { $(MaterialKind::$variant(m) => Shade::bsdf_at(m, p),)+ }
             }
 
             /// See [`Material::albedo`].
             pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
-                match self { $(MaterialKind::$variant(m) => m.albedo(uv),)+ }
+                match self { $(MaterialKind::$variant(m) => Shade::albedo(m, uv),)+ }
             }
 
             /// See [`Material::is_transmissive`].
             pub fn is_transmissive(&self) -> bool {
-                match self { $(MaterialKind::$variant(m) => m.is_transmissive(),)+ }
+                match self { $(MaterialKind::$variant(m) => Shade::is_transmissive(m),)+ }
             }
 
             /// The material a normal map, bump map or mask wraps; `None` for a material
             /// that scatters.
             pub fn nested(&self) -> Option<&MaterialKind> {
-                match self { $(MaterialKind::$variant(m) => m.nested(),)+ }
+                match self { $(MaterialKind::$variant(m) => Shade::nested(m),)+ }
             }
         }
 
-        $(impl From<$ty> for MaterialKind {
-            fn from(m: $ty) -> MaterialKind {
+        $(impl From<$kind> for MaterialKind {
+            fn from(m: $kind) -> MaterialKind {
                 MaterialKind::$variant(m)
             }
         })+
+
+        /// A material's BSDF at one point: textures looked up. Not `Copy`: a blend owns its
+        /// two parts (see `blend.rs`); every other variant is plain data.
+        #[derive(Clone, Debug)]
+        pub enum Bsdf {
+            $($($bvariant($bty),)*)+
+        }
+
+        // Inherent, so that callers of a `Bsdf` need not import `Scatter`.
+        impl Bsdf {
+            /// See [`Scatter::is_delta`].
+            pub fn is_delta(&self) -> bool {
+                match self { $($(Bsdf::$bvariant(b) => b.is_delta(),)*)+ }
+            }
+
+            /// See [`Scatter::has_delta_lobe`].
+            pub fn has_delta_lobe(&self) -> bool {
+                match self { $($(Bsdf::$bvariant(b) => b.has_delta_lobe(),)*)+ }
+            }
+
+            /// See [`Scatter::eval`].
+            pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+                match self { $($(Bsdf::$bvariant(b) => b.eval(wo, wi),)*)+ }
+            }
+
+            /// See [`Scatter::pdf`].
+            pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+                match self { $($(Bsdf::$bvariant(b) => b.pdf(wo, wi),)*)+ }
+            }
+
+            /// See [`Scatter::sample`].
+            pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
+                match self { $($(Bsdf::$bvariant(b) => b.sample(wo, u_lobe, u),)*)+ }
+            }
+
+            /// See [`Scatter::diffuse_reflectance`].
+            pub fn diffuse_reflectance(&self) -> Rgb {
+                match self { $($(Bsdf::$bvariant(b) => b.diffuse_reflectance(),)*)+ }
+            }
+
+            /// See [`Scatter::passage_transmission`].
+            pub fn passage_transmission(&self, wo: Vec3) -> Option<Rgb> {
+                match self { $($(Bsdf::$bvariant(b) => b.passage_transmission(wo),)*)+ }
+            }
+        }
+
+        $($(impl From<$bty> for Bsdf {
+            fn from(b: $bty) -> Bsdf {
+                Bsdf::$bvariant(b)
+            }
+        })*)+
     };
 }
 
 materials! {
-    /// Lambertian reflection.
-    Diffuse(DiffuseMaterial),
-    /// Whitted-style diffuse + glossy.
-    Phong(PhongMaterial),
-    /// Smooth metal.
-    Conductor(ConductorMaterial),
-    /// Microfacet metal.
-    RoughConductor(RoughConductorMaterial),
-    /// Smooth glass.
-    Dielectric(DielectricMaterial),
-    /// Rough glass.
-    RoughDielectric(RoughDielectricMaterial),
-    /// An infinitely thin slab of glass.
-    ThinDielectric(ThinDielectricMaterial),
-    /// Diffuse base under a coating.
-    Plastic(PlasticMaterial),
-    /// Absorbs everything.
-    Black(Black),
-    /// A normal-mapped material.
-    NormalMap(NormalMapMaterial),
-    /// A bump-mapped material.
-    BumpMap(BumpMapMaterial),
-    /// A material with an opacity.
-    Mask(MaskMaterial),
-    /// Lets light through unchanged: a medium's boundary.
-    Null(Null),
-    /// Mitsuba's `principled`, with its textured parameters.
-    Principled(PrincipledMaterial),
-    /// Mitsuba's `blendbsdf` of two material kinds.
-    Blend(BlendMaterial),
-    /// Mitsuba's `pplastic` (unpolarized).
-    PPlastic(PPlasticMaterial),
-    /// Mitsuba's `hair`.
-    Hair(HairBsdf),
-    /// A glTF 2.0 material with its textures.
-    Gltf(GltfMaterial),
+    /// Lambertian reflection (`diffuse`).
+    Diffuse(DiffuseDesc => DiffuseMaterial) [Diffuse(Diffuse)],
+    /// Diffuse plus a normalised Phong lobe (the Whitted integrator's glossy term).
+    Phong(PhongDesc => PhongMaterial) [Phong(Phong)],
+    /// Metal, smooth or rough (`conductor`, `roughconductor`).
+    Conductor(ConductorDesc => ConductorMaterial) [Conductor(Conductor), RoughConductor(RoughConductor)],
+    /// Glass, smooth, rough or thin (`dielectric`, `roughdielectric`, `thindielectric`).
+    Dielectric(DielectricDesc => DielectricMaterial)
+        [Dielectric(Dielectric), RoughDielectric(RoughDielectric), ThinDielectric(ThinDielectric)],
+    /// A diffuse base under a smooth or rough coating (`plastic`, `roughplastic`).
+    Plastic(PlasticDesc => PlasticMaterial) [Plastic(PlasticParams)],
+    /// Absorbs everything (emitters without a material).
+    Black(BlackDesc => Black) [Black(Black)],
+    /// A material shaded with a tangent-space normal map (`normalmap`).
+    NormalMap(NormalMapDesc => NormalMapMaterial) [],
+    /// A material shaded with the normals of a height field (`bumpmap`).
+    BumpMap(BumpMapDesc => BumpMapMaterial) [],
+    /// A material with an opacity (`mask`).
+    Mask(MaskDesc => MaskMaterial) [],
+    /// Lets light through unchanged (`null`): a medium's boundary.
+    Null(NullDesc => Null) [Null(Null)],
+    /// Mitsuba's `principled` (Disney) BSDF.
+    Principled(PrincipledDesc => PrincipledMaterial) [Principled(Principled)],
+    /// Mitsuba's `blendbsdf`: a weighted mixture of two materials.
+    Blend(BlendDesc => BlendMaterial) [Blend(BlendBsdf)],
+    /// Mitsuba's `pplastic` as its unpolarized variants render it.
+    PPlastic(PPlasticDesc => PPlasticMaterial) [PPlastic(PPlasticParams)],
+    /// Mitsuba's `hair` (Chiang et al. 2016), in a curve's frame (x around, y along).
+    Hair(HairDesc => HairBsdf) [Hair(HairBsdf)],
+    /// A glTF 2.0 metallic-roughness material with the KHR extensions.
+    Gltf(GltfMaterialDesc => GltfMaterial) [GltfPbr(GltfPbr)],
 }
 
-impl MaterialKind {
-    /// The material a description gives, its textures made (or found in the cache).
-    pub fn build(m: &MaterialModel, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
-        Ok(match m {
-            MaterialModel::Diffuse { reflectance } => DiffuseMaterial::build(reflectance, textures)?.into(),
-            MaterialModel::Phong { kd, ks, exponent } => PhongMaterial::build(kd, *ks, *exponent, textures)?.into(),
-            MaterialModel::Conductor { eta, k, specular, roughness } => {
-                conductor::build(*eta, *k, *specular, roughness.as_ref(), textures)?
-            }
-            MaterialModel::Dielectric { eta, reflect, transmit, roughness, thin } => {
-                dielectric::build(*eta, *reflect, *transmit, roughness.as_ref(), *thin, textures)?
-            }
-            MaterialModel::Plastic { diffuse, specular, eta, roughness, nonlinear } => {
-                PlasticMaterial::build(diffuse, *specular, *eta, roughness.as_ref(), *nonlinear, textures)?.into()
-            }
-            MaterialModel::Black => Black.into(),
-            MaterialModel::NormalMap { normals, nested } => NormalMapMaterial::build(normals, nested, textures)?.into(),
-            MaterialModel::BumpMap { height, scale, nested } => {
-                BumpMapMaterial::build(height, *scale, nested, textures)?.into()
-            }
-            MaterialModel::Mask { opacity, nested } => MaskMaterial::build(opacity, nested, textures)?.into(),
-            MaterialModel::Null => Null.into(),
-            MaterialModel::Principled(p) => PrincipledMaterial::build(p, textures)?.into(),
-            MaterialModel::Blend(b) => BlendMaterial::build(b, textures)?.into(),
-            MaterialModel::PPlastic { diffuse, specular, eta, roughness } => {
-                PPlasticMaterial::build(diffuse, *specular, *eta, roughness, textures)?.into()
-            }
-            MaterialModel::Hair(h) => hair::build(h).into(),
-            MaterialModel::Gltf(g) => gltf::build(g, textures)?,
-        })
+impl MaterialModel {
+    /// The mesh attributes (`vertex_...`, `face_...`) the material's textures read, with
+    /// where each is named.
+    pub fn mesh_attributes(&self) -> Vec<(&str, &SourceLoc)> {
+        self.textures()
+            .into_iter()
+            .filter_map(|t| match t {
+                TextureDesc::MeshAttribute { name, loc, .. } => Some((name.as_str(), loc)),
+                TextureDesc::Constant { .. }
+                | TextureDesc::Bitmap { .. }
+                | TextureDesc::Checkerboard { .. }
+                | TextureDesc::Gltf(_) => None,
+            })
+            .collect()
+    }
+}
+
+impl describe::MaterialSet for MaterialModel {
+    fn textures(&self) -> Vec<&TextureDesc> {
+        MaterialModel::textures(self)
     }
 
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        MaterialModel::textures_mut(self)
+    }
+}
+
+/// A scene description with glint's materials.
+pub type SceneDesc = describe::SceneDesc<MaterialModel>;
+
+/// A described material with glint's material set.
+pub type MaterialDesc = describe::MaterialDesc<MaterialModel>;
+
+impl MaterialKind {
     /// The BSDF at surface point `uv` (see [`MaterialKind::bsdf_at`]).
     #[inline]
     pub fn bsdf(&self, uv: [f32; 2]) -> Bsdf {

@@ -7,9 +7,12 @@
 //! material), [`Null`] passes light straight through unchanged (Mitsuba's `null`: the
 //! boundary of a medium).
 
-use super::{Bsdf, MaterialKind, Shade, TexturePoint};
+use super::{Bsdf, Describe, MaterialKind, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{BsdfSample, Scatter};
+use crate::describe::TextureDesc;
+use crate::error::Error;
 use crate::math::{Rgb, Vec3};
+use serde::{Deserialize, Serialize};
 
 /// Absorbs everything.
 #[derive(Clone, Copy, Debug)]
@@ -74,6 +77,41 @@ impl Scatter for Null {
         Some(Rgb::WHITE)
     }
 }
+
+/// `black` has no parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BlackDesc {}
+
+/// `null` has no parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NullDesc {}
+
+/// The description of a material without parameters: its built form is its BSDF.
+macro_rules! unit_describe {
+    ($($desc:ty => $built:expr),+) => {$(
+        impl Describe for $desc {
+            type Built = MaterialKind;
+
+            fn build(&self, _textures: &mut TextureCache) -> Result<MaterialKind, Error> {
+                Ok($built.into())
+            }
+
+            fn validate(&self) -> Result<(), String> {
+                Ok(())
+            }
+
+            fn textures(&self) -> Vec<&TextureDesc> {
+                Vec::new()
+            }
+
+            fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+                Vec::new()
+            }
+        }
+    )+};
+}
+
+unit_describe!(BlackDesc => Black, NullDesc => Null);
 
 impl Shade for Black {
     #[inline]

@@ -5,12 +5,13 @@
 //! Diffuse + normalised Phong lobe (Lafortune and Willems 1994): energy-conserving when
 //! kd + ks <= 1, so the same material works in the Whitted and the path tracer.
 
-use super::{Bsdf, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
+use super::{Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{reflect_local, BsdfSample, Scatter};
-use crate::describe::TextureDesc;
+use crate::describe::{checks, TextureDesc};
 use crate::error::Error;
 use crate::math::{Frame, Rgb, Vec3, INV_PI, PI};
 use crate::sampling::warp;
+use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Phong {
@@ -89,22 +90,49 @@ impl Scatter for Phong {
     }
 }
 
+/// `phong`'s parameters.
+///
+/// | Parameter | Type | Default (JSON) | |
+/// |---|---|---|---|
+/// | `kd` | texture | (required) | diffuse reflectance |
+/// | `ks` | colour | 0 | glossy reflectance |
+/// | `exponent` | float | 32 | Phong exponent, at least 0 |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PhongDesc {
+    pub kd: TextureDesc,
+    pub ks: Rgb,
+    pub exponent: f32,
+}
+
+impl Describe for PhongDesc {
+    type Built = PhongMaterial;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<PhongMaterial, Error> {
+        Ok(PhongMaterial { kd: textures.texture(&self.kd)?, ks: self.ks, exponent: self.exponent })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        checks::color(self.ks, "ks")?;
+        if !(self.exponent >= 0.0 && self.exponent.is_finite()) {
+            return Err(format!("Phong exponent {} must be finite and at least 0", self.exponent));
+        }
+        Ok(())
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        vec![&self.kd]
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        vec![&mut self.kd]
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct PhongMaterial {
     pub kd: Texture,
     pub ks: Rgb,
     pub exponent: f32,
-}
-
-impl PhongMaterial {
-    pub(crate) fn build(
-        kd: &TextureDesc,
-        ks: Rgb,
-        exponent: f32,
-        textures: &mut TextureCache,
-    ) -> Result<PhongMaterial, Error> {
-        Ok(PhongMaterial { kd: textures.texture(kd)?, ks, exponent })
-    }
 }
 
 impl Shade for PhongMaterial {

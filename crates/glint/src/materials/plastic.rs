@@ -13,12 +13,13 @@
 //! its internal reflectance (Mitsuba's `roughplastic` model), both integrated here with the
 //! rough dielectric BSDF.
 
-use super::{constant_microfacet, Bsdf, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
+use super::{constant_microfacet, Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, reflect_local, BsdfSample, Microfacet, Scatter};
-use crate::describe::{Roughness, TextureDesc};
+use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
@@ -269,6 +270,58 @@ mod tests {
     }
 }
 
+/// `plastic`'s and `roughplastic`'s parameters.
+///
+/// | Parameter | Type | Default (JSON, Mitsuba) | |
+/// |---|---|---|---|
+/// | `diffuse` | texture | (JSON: required; Mitsuba 0.5) | the base's albedo |
+/// | `specular` | colour | 1 | the coating's tint |
+/// | `eta` | float | 1.49 (JSON `ior`) | the coating's index |
+/// | `roughness` | roughness | none: smooth | one isotropic, untextured `alpha` |
+/// | `nonlinear` | bool | false | Mitsuba's `nonlinear` internal scattering |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlasticDesc {
+    pub diffuse: TextureDesc,
+    pub specular: Rgb,
+    pub eta: f32,
+    pub roughness: Option<Roughness>,
+    /// Mitsuba's `nonlinear`: the internal scattering series divides the albedo ρ by
+    /// 1 - ρ F_dr instead of 1 - F_dr, which darkens and saturates colours.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub nonlinear: bool,
+}
+
+impl Describe for PlasticDesc {
+    type Built = PlasticMaterial;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<PlasticMaterial, Error> {
+        let dist = self.roughness.as_ref().map(constant_microfacet).transpose()?;
+        let diffuse = textures.texture(&self.diffuse)?;
+        Ok(if self.nonlinear {
+            PlasticMaterial::nonlinear(diffuse, self.specular, self.eta, dist)
+        } else {
+            PlasticMaterial::new(diffuse, self.specular, self.eta, dist)
+        })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        checks::eta(self.eta)?;
+        checks::color(self.specular, "specular reflectance")?;
+        checks::roughness(self.roughness.as_ref())
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        let rough = self.roughness.as_ref().map_or(Vec::new(), Roughness::textures);
+        [vec![&self.diffuse], rough].concat()
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        let mut textures = vec![&mut self.diffuse];
+        textures.extend(self.roughness.as_mut().map_or(Vec::new(), Roughness::textures_mut));
+        textures
+    }
+}
+
 /// Diffuse base under a coating; `params` holds everything but the textured albedo.
 #[derive(Clone, Debug)]
 pub struct PlasticMaterial {
@@ -285,23 +338,6 @@ impl PlasticMaterial {
     pub fn nonlinear(diffuse: Texture, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> PlasticMaterial {
         let params = PlasticParams { nonlinear: true, ..PlasticParams::new(Rgb::BLACK, specular, eta, dist) };
         PlasticMaterial { diffuse, params }
-    }
-
-    pub(crate) fn build(
-        diffuse: &TextureDesc,
-        specular: Rgb,
-        eta: f32,
-        roughness: Option<&Roughness>,
-        nonlinear: bool,
-        textures: &mut TextureCache,
-    ) -> Result<PlasticMaterial, Error> {
-        let dist = roughness.map(constant_microfacet).transpose()?;
-        let diffuse = textures.texture(diffuse)?;
-        Ok(if nonlinear {
-            PlasticMaterial::nonlinear(diffuse, specular, eta, dist)
-        } else {
-            PlasticMaterial::new(diffuse, specular, eta, dist)
-        })
     }
 }
 

@@ -9,12 +9,13 @@
 //! (unlike `roughplastic`). The lobes are chosen with a fixed probability, the specular
 //! reflectance's share of the two albedos.
 
-use super::{roughness_map, Bsdf, MaterialKind, RoughnessMap, Shade, Texture, TextureCache, TexturePoint};
+use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, BsdfSample, Microfacet, Scatter};
-use crate::describe::{Roughness, TextureDesc};
+use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3, INV_PI};
 use crate::sampling::warp;
+use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug)]
 pub struct PPlasticParams {
@@ -77,6 +78,50 @@ impl Scatter for PPlasticParams {
     }
 }
 
+/// `pplastic`'s parameters.
+///
+/// | Parameter | Type | Default (JSON, Mitsuba) | |
+/// |---|---|---|---|
+/// | `diffuse` | texture | (JSON: required; Mitsuba 0.5) | the base's albedo |
+/// | `specular` | colour | 1 | the specular lobe's tint |
+/// | `eta` | float | 1.49 (JSON `ior`) | the coating's index |
+/// | `roughness` | roughness | Beckmann, alpha 0.1 | (textured) `alpha`, `alpha_v` |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PPlasticDesc {
+    pub diffuse: TextureDesc,
+    pub specular: Rgb,
+    pub eta: f32,
+    pub roughness: Roughness,
+}
+
+impl Describe for PPlasticDesc {
+    type Built = PPlasticMaterial;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<PPlasticMaterial, Error> {
+        let diffuse = textures.texture(&self.diffuse)?;
+        let (d, s) = (diffuse.mean().average(), self.specular.average());
+        let specular_probability = if d + s > 0.0 { s / (d + s) } else { 0.5 };
+        let dist = roughness_map(&self.roughness, textures)?;
+        Ok(PPlasticMaterial { diffuse, specular: self.specular, eta: self.eta, dist, specular_probability })
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        checks::eta(self.eta)?;
+        checks::color(self.specular, "specular reflectance")?;
+        checks::roughness(Some(&self.roughness))
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        [vec![&self.diffuse], self.roughness.textures()].concat()
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        let mut textures = vec![&mut self.diffuse];
+        textures.extend(self.roughness.textures_mut());
+        textures
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct PPlasticMaterial {
     pub diffuse: Texture,
@@ -84,21 +129,6 @@ pub struct PPlasticMaterial {
     pub eta: f32,
     pub dist: RoughnessMap,
     pub specular_probability: f32,
-}
-
-impl PPlasticMaterial {
-    pub(crate) fn build(
-        diffuse: &TextureDesc,
-        specular: Rgb,
-        eta: f32,
-        roughness: &Roughness,
-        textures: &mut TextureCache,
-    ) -> Result<PPlasticMaterial, Error> {
-        let diffuse = textures.texture(diffuse)?;
-        let (d, s) = (diffuse.mean().average(), specular.average());
-        let specular_probability = if d + s > 0.0 { s / (d + s) } else { 0.5 };
-        Ok(PPlasticMaterial { diffuse, specular, eta, dist: roughness_map(roughness, textures)?, specular_probability })
-    }
 }
 
 impl Shade for PPlasticMaterial {

@@ -3,10 +3,11 @@
 //! material it wraps; its own BSDF is black, the nested one scattering.
 
 use super::{Black, Bsdf};
-use super::{Material, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
-use crate::describe::{MaterialModel, TextureDesc};
+use super::{Describe, Material, MaterialKind, MaterialModel, Shade, Texture, TextureCache, TexturePoint};
+use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::math::Rgb;
+use serde::{Deserialize, Serialize};
 
 /// How a material tilts its shading frame.
 #[derive(Clone, Copy, Debug)]
@@ -40,48 +41,82 @@ pub struct MaskMaterial {
     pub nested: Box<MaterialKind>,
 }
 
+/// `normalmap`'s, `bumpmap`'s and `mask`'s description: the texture and the material it
+/// wraps.
+///
+/// | Parameter | Type | Default | |
+/// |---|---|---|---|
+/// | `normals` / `height` / `opacity` | texture | (required) | a tangent-space normal map; a height field; the probability of being there |
+/// | `scale` (bump map) | float | 1 | height scale |
+/// | `nested` | material | (required) | the material that scatters |
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NormalMapDesc {
+    pub normals: TextureDesc,
+    pub nested: Box<MaterialModel>,
+}
+
+/// See [`NormalMapDesc`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BumpMapDesc {
+    pub height: TextureDesc,
+    pub scale: f32,
+    pub nested: Box<MaterialModel>,
+}
+
+/// See [`NormalMapDesc`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MaskDesc {
+    pub opacity: TextureDesc,
+    pub nested: Box<MaterialModel>,
+}
+
 /// A wrapper's texture and nested material, built.
 fn wrap(
     t: &TextureDesc,
     nested: &MaterialModel,
     textures: &mut TextureCache,
 ) -> Result<(Texture, Box<MaterialKind>), Error> {
-    Ok((textures.texture(t)?, Box::new(MaterialKind::build(nested, textures)?)))
+    Ok((textures.texture(t)?, Box::new(nested.build(textures)?)))
 }
 
-impl NormalMapMaterial {
-    pub(crate) fn build(
-        normals: &TextureDesc,
-        nested: &MaterialModel,
-        textures: &mut TextureCache,
-    ) -> Result<Self, Error> {
-        let (normals, nested) = wrap(normals, nested, textures)?;
-        Ok(NormalMapMaterial { normals, nested })
-    }
+/// The wrapper description `$desc` of texture field `$tex`, built as `$built`, with `$check`
+/// its own parameters' check beside the nested material's.
+macro_rules! wrapper_describe {
+    ($desc:ty, $tex:ident, $built:ident { $($extra:ident),* }, $check:expr) => {
+        impl Describe for $desc {
+            type Built = $built;
+
+            fn build(&self, textures: &mut TextureCache) -> Result<$built, Error> {
+                let ($tex, nested) = wrap(&self.$tex, &self.nested, textures)?;
+                Ok($built { $tex, $($extra: self.$extra,)* nested })
+            }
+
+            fn validate(&self) -> Result<(), String> {
+                let check: fn(&$desc) -> Result<(), String> = $check;
+                check(self)?;
+                self.nested.validate()
+            }
+
+            fn textures(&self) -> Vec<&TextureDesc> {
+                std::iter::once(&self.$tex).chain(self.nested.textures()).collect()
+            }
+
+            fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+                std::iter::once(&mut self.$tex).chain(self.nested.textures_mut()).collect()
+            }
+        }
+    };
 }
 
-impl BumpMapMaterial {
-    pub(crate) fn build(
-        height: &TextureDesc,
-        scale: f32,
-        nested: &MaterialModel,
-        textures: &mut TextureCache,
-    ) -> Result<Self, Error> {
-        let (height, nested) = wrap(height, nested, textures)?;
-        Ok(BumpMapMaterial { height, scale, nested })
+wrapper_describe!(NormalMapDesc, normals, NormalMapMaterial {}, |_| Ok(()));
+wrapper_describe!(MaskDesc, opacity, MaskMaterial {}, |_| Ok(()));
+wrapper_describe!(BumpMapDesc, height, BumpMapMaterial { scale }, |d| {
+    if d.scale.is_finite() {
+        Ok(())
+    } else {
+        Err(format!("bump map scale {} must be finite", d.scale))
     }
-}
-
-impl MaskMaterial {
-    pub(crate) fn build(
-        opacity: &TextureDesc,
-        nested: &MaterialModel,
-        textures: &mut TextureCache,
-    ) -> Result<Self, Error> {
-        let (opacity, nested) = wrap(opacity, nested, textures)?;
-        Ok(MaskMaterial { opacity, nested })
-    }
-}
+});
 
 /// The wrappers answer as black, non-transmissive surfaces: the integrators ask the nested
 /// material ([`MaterialKind::base`]).

@@ -14,8 +14,13 @@
 
 use super::Session;
 use crate::assemble::{patch_appearance, BuildCounters};
-use crate::describe::{Emission, LightKind, MaterialModel, Matrix4, Roughness, ScalarTexture, SceneDesc, TextureDesc};
+use crate::describe::{Emission, LightKind, Matrix4, Roughness, ScalarTexture, TextureDesc};
 use crate::error::Error;
+use crate::materials::{
+    BlackDesc, BumpMapDesc, ConductorDesc, DielectricDesc, DiffuseDesc, MaskDesc, NormalMapDesc, NullDesc,
+    PPlasticDesc, PhongDesc, PlasticDesc,
+};
+use crate::materials::{MaterialModel, SceneDesc};
 use crate::math::Rgb;
 use std::sync::Arc;
 
@@ -112,49 +117,49 @@ fn texture_slot<'a>(name: &'static str, t: &'a mut TextureDesc, out: &mut Vec<(&
 fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
     let mut out = Vec::new();
     match m {
-        MaterialModel::Diffuse { reflectance } => texture_slot("reflectance", reflectance, &mut out),
-        MaterialModel::Phong { kd, ks, exponent } => {
+        MaterialModel::Diffuse(DiffuseDesc { reflectance }) => texture_slot("reflectance", reflectance, &mut out),
+        MaterialModel::Phong(PhongDesc { kd, ks, exponent }) => {
             texture_slot("kd", kd, &mut out);
             out.push(("ks", Slot::Color(ks)));
             out.push(("exponent", Slot::Float(exponent)));
         }
-        MaterialModel::Conductor { eta, k, specular, roughness } => {
+        MaterialModel::Conductor(ConductorDesc { eta, k, specular, roughness }) => {
             out.push(("eta", Slot::Color(eta)));
             out.push(("k", Slot::Color(k)));
             out.push(("specular", Slot::Color(specular)));
             roughness_slots(roughness, &mut out);
         }
-        MaterialModel::Dielectric { eta, reflect, transmit, roughness, .. } => {
+        MaterialModel::Dielectric(DielectricDesc { eta, reflect, transmit, roughness, .. }) => {
             out.push(("eta", Slot::Float(eta)));
             out.push(("reflect", Slot::Color(reflect)));
             out.push(("transmit", Slot::Color(transmit)));
             roughness_slots(roughness, &mut out);
         }
-        MaterialModel::Plastic { diffuse, specular, eta, roughness, .. } => {
+        MaterialModel::Plastic(PlasticDesc { diffuse, specular, eta, roughness, .. }) => {
             texture_slot("diffuse", diffuse, &mut out);
             out.push(("specular", Slot::Color(specular)));
             out.push(("eta", Slot::Float(eta)));
             roughness_slots(roughness, &mut out);
         }
-        MaterialModel::PPlastic { diffuse, specular, eta, roughness } => {
+        MaterialModel::PPlastic(PPlasticDesc { diffuse, specular, eta, roughness }) => {
             texture_slot("diffuse", diffuse, &mut out);
             out.push(("specular", Slot::Color(specular)));
             out.push(("eta", Slot::Float(eta)));
             roughness_value_slots(roughness, &mut out);
         }
-        MaterialModel::Black | MaterialModel::Null | MaterialModel::Hair(_) => {}
+        MaterialModel::Black(BlackDesc {}) | MaterialModel::Null(NullDesc {}) | MaterialModel::Hair(_) => {}
         // The wrapped material's parameters, and a mask's constant opacity.
-        MaterialModel::NormalMap { nested, .. } => return material_slots(nested),
-        MaterialModel::BumpMap { scale, nested, .. } => {
+        MaterialModel::NormalMap(NormalMapDesc { nested, .. }) => return material_slots(nested),
+        MaterialModel::BumpMap(BumpMapDesc { scale, nested, .. }) => {
             out.push(("bump_scale", Slot::Float(scale)));
             out.extend(material_slots(nested));
         }
-        MaterialModel::Mask { opacity, nested } => {
+        MaterialModel::Mask(MaskDesc { opacity, nested }) => {
             texture_slot("opacity", opacity, &mut out);
             out.extend(material_slots(nested));
         }
         MaterialModel::Principled(p) => {
-            for (name, t) in crate::describe::PrincipledDesc::TEXTURE_NAMES.into_iter().zip(p.textures_mut()) {
+            for (name, t) in crate::materials::PrincipledDesc::TEXTURE_NAMES.into_iter().zip(p.textures_mut()) {
                 texture_slot(name, t, &mut out);
             }
         }

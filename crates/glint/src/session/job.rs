@@ -3,8 +3,8 @@
 //! two films merge only when their jobs agree (`output` aside).
 
 use crate::accel::BvhSplit;
-use crate::describe::SceneDesc;
 use crate::error::Error;
+use crate::materials::SceneDesc;
 use crate::render::{Adaptive, Aov};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;

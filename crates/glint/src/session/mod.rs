@@ -44,10 +44,10 @@ pub use outputs::{check_output, layer_channels, layer_names, output_files, Outpu
 pub use overrides::{integrator_name, integrator_names, Overrides};
 
 use crate::assemble::{build_cached, BuildOptions, MeshCache, WorldLayout};
-use crate::describe::SceneDesc;
 use crate::error::{Error, SourceLoc};
 use crate::formats::{read, ReadOptions};
 use crate::integrators::Integrator;
+use crate::materials::SceneDesc;
 use crate::preview::{film_spp, FilmSink, RenderProgress};
 use crate::render::{
     read_film, render_passes, write_film, Adaptive, Aov, ContentHash, Film, FilmMeta, PassRequest, Progress, Rect,

@@ -5,11 +5,11 @@
 //! temporary name and renamed.
 
 use crate::denoise::Denoiser;
-use crate::describe::SceneDesc;
 use crate::error::{Error, SourceLoc};
 use crate::io::image_io::ImageFormat;
 use crate::io::layers::{write_exr_channels, Channel};
 use crate::io::Image;
+use crate::materials::SceneDesc;
 use crate::math::Rgb;
 use crate::render::{Aov, AovImage, Film};
 use std::path::{Path, PathBuf};

@@ -4,11 +4,11 @@
 
 use crate::camera::CropWindow;
 use crate::describe::{
-    limits, DirectSettings, IntegratorDesc, PathSettings, SamplerDesc, SceneDesc, Strategy, VolpathSettings,
-    WhittedSettings,
+    limits, DirectSettings, IntegratorDesc, PathSettings, SamplerDesc, Strategy, VolpathSettings, WhittedSettings,
 };
 use crate::error::Error;
 use crate::lights::LightSelection;
+use crate::materials::SceneDesc;
 use crate::sampling::SamplerKind;
 use std::sync::OnceLock;
 

@@ -11,7 +11,7 @@ use crate::accel::{prefetch, BvhSplit, FlatMesh, TopLevelBvh};
 use crate::camera::Camera;
 use crate::geometry::{CurveHit, Curves, Cylinder, SdfGrid, Sphere, TriangleMesh};
 use crate::lights::{self, Light, LightSample, LightSelection, LightTree};
-use crate::materials::{Material, MaterialKind, Texture, TexturePoint};
+use crate::materials::{DielectricSurface, Material, MaterialKind, Texture, TexturePoint};
 use crate::math::{Aabb, Frame, Ray, Rgb, Transform, Vec3};
 use crate::media::{Medium, MediumBoundary};
 use crate::sampling::Distribution1d;
@@ -175,8 +175,10 @@ impl World {
     /// Sets the flags that say which materials the scene has; called whenever they change.
     pub(crate) fn update_material_flags(&mut self) {
         self.has_masks = self.materials.iter().any(Material::may_pass_rays);
-        self.has_passage_materials =
-            self.materials.iter().any(|m| matches!(m.kind, MaterialKind::Null(_) | MaterialKind::ThinDielectric(_)));
+        self.has_passage_materials = self.materials.iter().any(|m| {
+            matches!(&m.kind, MaterialKind::Null(_))
+                || matches!(&m.kind, MaterialKind::Dielectric(d) if matches!(d.surface, DielectricSurface::Thin))
+        });
     }
 
     /// The share of next-event light choices made by power under `LightSelection::Power`; the

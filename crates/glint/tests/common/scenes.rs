@@ -7,7 +7,7 @@ use glint::camera::{Camera, FovAxis};
 use glint::geometry::{cube_mesh, quad_mesh};
 use glint::integrators::{Integrator, PathSettings, Strategy};
 use glint::lights::{AreaEmission, LightSelection};
-use glint::materials::{DielectricMaterial, DiffuseMaterial, Material, MaterialKind, RoughConductorMaterial, Texture};
+use glint::materials::{ConductorMaterial, DielectricMaterial, DiffuseMaterial, Material, MaterialKind, Texture};
 use glint::math::{vec3, Rgb, Transform, Vec3};
 use glint::render::{render, PixelFilter, RenderOutput, RenderSettings, Schedule, Silent};
 use glint::sampling::SamplerKind;
@@ -92,8 +92,8 @@ pub fn black(b: &mut WorldBuilder) -> u32 {
 pub fn rough_mirror(b: &mut WorldBuilder, name: &str, alpha: f32) -> u32 {
     b.add_material(Material::new(
         name,
-        MaterialKind::RoughConductor(RoughConductorMaterial {
-            dist: Microfacet::new(MicrofacetKind::Ggx, alpha).into(),
+        MaterialKind::Conductor(ConductorMaterial {
+            roughness: Some(Microfacet::new(MicrofacetKind::Ggx, alpha).into()),
             eta: Rgb::BLACK,
             k: Rgb::WHITE,
             specular: Rgb::WHITE,
@@ -173,7 +173,7 @@ pub fn cornell_box_with(width: u32, height: u32, extra: impl FnOnce(&mut WorldBu
 pub fn add_glass_and_metal_balls(b: &mut WorldBuilder) -> (u32, u32) {
     let glass = b.add_material(Material::new(
         "glass",
-        MaterialKind::Dielectric(DielectricMaterial { eta: 1.5, reflect: Rgb::WHITE, transmit: Rgb::WHITE }),
+        MaterialKind::Dielectric(DielectricMaterial::smooth(1.5, Rgb::WHITE, Rgb::WHITE)),
         false,
     ));
     let metal = rough_mirror(b, "metal", 0.2);

@@ -4,8 +4,9 @@
 
 use super::mul;
 use super::scene::Walk;
-use crate::describe::{FovAxis, Matrix4, Projection, SceneDesc};
+use crate::describe::{FovAxis, Matrix4, Projection};
 use crate::io::gltf::{GltfFile, Node};
+use crate::materials::SceneDesc;
 use serde_json::Value;
 
 /// Film height when a camera gives the aspect ratio; both sides default to 640 x 480.

@@ -3,9 +3,10 @@
 //! 1 lx -> 1/683 W/m^2), as Blender's importer does.
 
 use super::scene::Walk;
-use crate::describe::{LightDesc, LightKind, Matrix4, SceneDesc, SpotFalloff};
+use crate::describe::{LightDesc, LightKind, Matrix4, SpotFalloff};
 use crate::error::SourceLoc;
 use crate::io::gltf::{GltfFile, Node};
+use crate::materials::SceneDesc;
 use crate::math::{rgb, vec3, Vec3};
 use serde_json::Value;
 

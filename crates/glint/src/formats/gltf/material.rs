@@ -2,12 +2,11 @@
 //! the KHR material extensions Blender writes, and the emission each material gives the
 //! shapes that use it.
 
-use crate::describe::{
-    Emission, GltfAlphaMode, GltfMaterialDesc, GltfTextureDesc, GltfWrap, MaterialDesc, MaterialModel, MediumDesc,
-    PhaseDesc, SceneDesc, TextureDesc, VolumeDesc,
-};
+use crate::describe::{Emission, GltfTextureDesc, GltfWrap, MediumDesc, PhaseDesc, TextureDesc, VolumeDesc};
+
 use crate::error::SourceLoc;
 use crate::io::gltf::{GltfFile, Node};
+use crate::materials::{GltfAlphaMode, GltfMaterialDesc, MaterialDesc, MaterialModel, SceneDesc};
 use crate::math::{rgb, Rgb};
 use serde_json::Value;
 use std::cell::Cell;

@@ -10,11 +10,11 @@ mod lights;
 mod material;
 mod scene;
 
-use crate::describe::{
-    CameraDesc, FilmDesc, IntegratorDesc, Matrix4, PixelFilter, SceneDesc, VolpathSettings, IDENTITY,
-};
+use crate::describe::{CameraDesc, FilmDesc, IntegratorDesc, Matrix4, PixelFilter, VolpathSettings, IDENTITY};
+
 use crate::error::{Error, SourceLoc};
 use crate::io::gltf::GltfFile;
+use crate::materials::SceneDesc;
 use serde_json::Value;
 use std::path::Path;
 

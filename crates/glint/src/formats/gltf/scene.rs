@@ -4,9 +4,10 @@
 
 use super::material::Materials;
 use super::mul;
-use crate::describe::{Emission, Geometry, MaterialRef, Matrix4, MeshFileDesc, SceneDesc, ShapeDesc, IDENTITY};
+use crate::describe::{Emission, Geometry, MaterialRef, Matrix4, MeshFileDesc, ShapeDesc, IDENTITY};
 use crate::error::SourceLoc;
 use crate::io::gltf::{read_accessor, read_primitive, triangle_mode, GltfFile, Node, PrimitiveMode};
+use crate::materials::SceneDesc;
 use crate::math::Aabb;
 use serde_json::Value;
 use std::collections::HashMap;

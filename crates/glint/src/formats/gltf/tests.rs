@@ -3,8 +3,9 @@
 //! and errors that name the JSON path.
 
 use super::describe;
-use crate::describe::{Geometry, SceneDesc};
+use crate::describe::Geometry;
 use crate::io::gltf::{assemble_triangles, read_accessor, GltfFile, PrimitiveMode};
+use crate::materials::SceneDesc;
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -230,7 +231,8 @@ fn an_attenuating_volume_is_an_absorbing_medium_inside_its_surface() {
 
 #[test]
 fn extension_textures_are_read_with_their_colour_spaces_and_errors_name_them() {
-    use crate::describe::{MaterialModel, TextureDesc};
+    use crate::describe::TextureDesc;
+    use crate::materials::MaterialModel;
     let t = |i: usize| json!({"index": i});
     let with_textures = |ext: Value| {
         let mut d = material_doc(ext);

@@ -8,11 +8,13 @@ use super::roughness::RoughnessInput;
 use super::spectrum::SpectrumUse;
 use super::xml::Element;
 use super::{named_ior, props, Reader};
-use crate::describe::{
-    principled_eta_of_specular, BlendDesc, BlendPartDesc, MaterialDesc, MaterialModel, PrincipledDesc, TextureDesc,
-};
+use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::materials::conductor_preset;
+use crate::materials::{
+    principled_eta_of_specular, BlendDesc, BlendPartDesc, MaterialDesc, MaterialModel, PrincipledDesc,
+};
+use crate::materials::{ConductorDesc, DielectricDesc, DiffuseDesc, NullDesc, PlasticDesc};
 use crate::math::Rgb;
 
 impl<'a> Reader<'a> {
@@ -49,7 +51,7 @@ impl<'a> Reader<'a> {
             "plastic" => self.plastic(&p, false)?,
             "roughplastic" => self.plastic(&p, true)?,
             // Passes light through unchanged: the boundary of a medium (see the volpath integrator).
-            "null" => MaterialModel::Null,
+            "null" => MaterialModel::Null(NullDesc {}),
             "principled" => self.principled(&p)?,
             "blendbsdf" => self.blend(&p)?,
             "pplastic" => self.pplastic(&p)?,
@@ -73,14 +75,19 @@ impl<'a> Reader<'a> {
     }
 
     fn diffuse(&self, p: &Props<'a>) -> Result<MaterialModel, Error> {
-        Ok(MaterialModel::Diffuse { reflectance: self.texture(p, "reflectance", Rgb::splat(0.5))? })
+        Ok(MaterialModel::Diffuse(DiffuseDesc { reflectance: self.texture(p, "reflectance", Rgb::splat(0.5))? }))
     }
 
     /// `conductor` and (`rough`) `roughconductor`.
     fn conductor(&self, p: &Props<'a>, rough: bool) -> Result<MaterialModel, Error> {
         let roughness = if rough { Some(self.roughness(p, RoughnessInput::Textured)?) } else { None };
         let (eta, k) = self.conductor_ior(p)?;
-        Ok(MaterialModel::Conductor { eta, k, specular: p.rgb("specular_reflectance", Rgb::WHITE)?, roughness })
+        Ok(MaterialModel::Conductor(ConductorDesc {
+            eta,
+            k,
+            specular: p.rgb("specular_reflectance", Rgb::WHITE)?,
+            roughness,
+        }))
     }
 
     /// `dielectric`, `roughdielectric` and `thindielectric`.
@@ -92,7 +99,13 @@ impl<'a> Reader<'a> {
             DielectricForm::Rough => Some(self.roughness(p, RoughnessInput::Textured)?),
             DielectricForm::Smooth | DielectricForm::Thin => None,
         };
-        Ok(MaterialModel::Dielectric { eta, reflect, transmit, roughness, thin: form == DielectricForm::Thin })
+        Ok(MaterialModel::Dielectric(DielectricDesc {
+            eta,
+            reflect,
+            transmit,
+            roughness,
+            thin: form == DielectricForm::Thin,
+        }))
     }
 
     /// `plastic` and (`rough`) `roughplastic`.
@@ -102,7 +115,7 @@ impl<'a> Reader<'a> {
         let specular = p.rgb("specular_reflectance", Rgb::WHITE)?;
         let nonlinear = p.bool("nonlinear", false)?;
         let roughness = if rough { Some(self.roughness(p, RoughnessInput::IsotropicNumber)?) } else { None };
-        Ok(MaterialModel::Plastic { diffuse, specular, eta, roughness, nonlinear })
+        Ok(MaterialModel::Plastic(PlasticDesc { diffuse, specular, eta, roughness, nonlinear }))
     }
 
     pub(super) fn ior(&self, p: &Props, name: &str, default: f32) -> Result<f32, Error> {

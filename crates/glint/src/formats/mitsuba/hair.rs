@@ -5,8 +5,8 @@
 use super::props::Props;
 use super::spectrum::SpectrumUse;
 use super::Reader;
-use crate::describe::{HairDesc, MaterialModel};
 use crate::error::Error;
+use crate::materials::{HairDesc, MaterialModel};
 use crate::materials::{EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
 use crate::math::Rgb;
 

@@ -18,12 +18,12 @@ pub mod xml;
 
 use super::Define;
 use crate::describe::{
-    Aov, CameraDesc, CurveBasisDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialDesc,
-    MaterialRef, MediumDesc, PathSettings, SamplerDesc, SceneDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc,
-    VolpathSettings,
+    Aov, CameraDesc, CurveBasisDesc, Emission, FilmDesc, Geometry, IntegratorDesc, LightDesc, LightKind, MaterialRef,
+    MediumDesc, PathSettings, SamplerDesc, SdfNormalsDesc, ShapeDesc, ShapeMedia, TextureDesc, VolpathSettings,
 };
 use crate::describe::{CropWindow, FovAxis, PixelFilter, Projection, SamplerKind, SpotFalloff};
 use crate::error::{Error, SourceLoc};
+use crate::materials::{MaterialDesc, SceneDesc};
 use crate::math::{Rgb, Transform, Vec3};
 use props::{color_of, Props};
 use spectrum::SpectrumUse;

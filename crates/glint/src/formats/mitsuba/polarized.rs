@@ -6,8 +6,9 @@
 use super::props::Props;
 use super::roughness::RoughnessInput;
 use super::Reader;
-use crate::describe::MaterialModel;
 use crate::error::Error;
+use crate::materials::MaterialModel;
+use crate::materials::{DielectricDesc, PPlasticDesc};
 use crate::math::Rgb;
 
 impl<'a> Reader<'a> {
@@ -27,7 +28,7 @@ impl<'a> Reader<'a> {
             int_ior / ext_ior
         };
         let roughness = self.roughness(p, RoughnessInput::Textured)?;
-        Ok(MaterialModel::PPlastic { diffuse, specular, eta, roughness })
+        Ok(MaterialModel::PPlastic(PPlasticDesc { diffuse, specular, eta, roughness }))
     }
 
     /// A polarizer: transmits half of `transmittance` straight through, from either side,
@@ -38,12 +39,12 @@ impl<'a> Reader<'a> {
         let _ = p.find("theta");
         let _ = p.bool("polarizing", true)?;
         let transmittance = p.rgb("transmittance", Rgb::WHITE)?;
-        Ok(MaterialModel::Dielectric {
+        Ok(MaterialModel::Dielectric(DielectricDesc {
             eta: 1.0,
             reflect: Rgb::BLACK,
             transmit: transmittance * 0.5,
             roughness: None,
             thin: true,
-        })
+        }))
     }
 }

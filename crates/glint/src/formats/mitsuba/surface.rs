@@ -4,8 +4,10 @@
 use super::props::Props;
 use super::xml::Element;
 use super::Reader;
-use crate::describe::{MaterialModel, TextureDesc};
+use crate::describe::TextureDesc;
 use crate::error::Error;
+use crate::materials::MaterialModel;
+use crate::materials::{BlackDesc, BumpMapDesc, MaskDesc, NormalMapDesc, NullDesc};
 use crate::math::Rgb;
 
 impl<'a> Reader<'a> {
@@ -33,18 +35,18 @@ impl<'a> Reader<'a> {
             let mut m = m;
             loop {
                 match m {
-                    MaterialModel::NormalMap { .. } | MaterialModel::BumpMap { .. } => return true,
-                    MaterialModel::Mask { nested, .. } => m = nested,
-                    MaterialModel::Diffuse { .. }
-                    | MaterialModel::Phong { .. }
-                    | MaterialModel::Conductor { .. }
-                    | MaterialModel::Dielectric { .. }
-                    | MaterialModel::Plastic { .. }
-                    | MaterialModel::Black
-                    | MaterialModel::Null
+                    MaterialModel::NormalMap(_) | MaterialModel::BumpMap(_) => return true,
+                    MaterialModel::Mask(MaskDesc { nested, .. }) => m = nested,
+                    MaterialModel::Diffuse(_)
+                    | MaterialModel::Phong(_)
+                    | MaterialModel::Conductor(_)
+                    | MaterialModel::Dielectric(_)
+                    | MaterialModel::Plastic(_)
+                    | MaterialModel::Black(BlackDesc {})
+                    | MaterialModel::Null(NullDesc {})
                     | MaterialModel::Principled(_)
                     | MaterialModel::Blend(_)
-                    | MaterialModel::PPlastic { .. }
+                    | MaterialModel::PPlastic(_)
                     | MaterialModel::Hair(_)
                     | MaterialModel::Gltf(_) => return false,
                 }
@@ -66,7 +68,10 @@ impl<'a> Reader<'a> {
                 if p.find("normalmap").is_none() {
                     return Err(el.err("normalmap: needs a texture named 'normalmap'"));
                 }
-                MaterialModel::NormalMap { normals: self.texture(&p, "normalmap", Rgb::splat(0.5))?, nested }
+                MaterialModel::NormalMap(NormalMapDesc {
+                    normals: self.texture(&p, "normalmap", Rgb::splat(0.5))?,
+                    nested,
+                })
             }
             "bumpmap" => {
                 let textures: Vec<&Element> = el
@@ -90,9 +95,9 @@ impl<'a> Reader<'a> {
                 if let Some(name) = t.attr("name") {
                     p.find(name);
                 }
-                MaterialModel::BumpMap { height, scale: p.float("scale", 1.0)?, nested }
+                MaterialModel::BumpMap(BumpMapDesc { height, scale: p.float("scale", 1.0)?, nested })
             }
-            _ => MaterialModel::Mask { opacity: self.texture(&p, "opacity", Rgb::splat(0.5))?, nested },
+            _ => MaterialModel::Mask(MaskDesc { opacity: self.texture(&p, "opacity", Rgb::splat(0.5))?, nested }),
         };
         self.warn_unused(&p);
         Ok((model, two_sided))

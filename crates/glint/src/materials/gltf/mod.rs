@@ -2,14 +2,16 @@
 //! (an image with its sampler, texture coordinate set and `KHR_texture_transform`).
 
 mod bsdf;
+mod desc;
 mod lobes;
 
 pub use bsdf::GltfPbr;
+pub use desc::{GltfAlphaMode, GltfMaterialDesc};
 pub use lobes::{sheen_albedo, sheen_albedo_quadrature, SHEEN_ALBEDO_TOLERANCE, SHEEN_MIN_ROUGHNESS};
 
-use super::{Black, Bsdf};
+use super::{Black, Bsdf, Describe};
 use super::{MaskMaterial, MaterialKind, NormalMapMaterial, Shade, Texture, TextureCache, TexturePoint};
-use crate::describe::{GltfAlphaMode, GltfMaterialDesc, GltfWrap};
+use crate::describe::{checks, GltfWrap, TextureDesc};
 use crate::error::Error;
 use crate::io::gltf::RgbaImage;
 use crate::math::{rgb, Rgb};
@@ -296,9 +298,29 @@ impl Shade for GltfMaterial {
     }
 }
 
+impl Describe for GltfMaterialDesc {
+    type Built = MaterialKind;
+
+    fn build(&self, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
+        build_gltf(self, textures)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        check_gltf(self)
+    }
+
+    fn textures(&self) -> Vec<&TextureDesc> {
+        GltfMaterialDesc::textures(self)
+    }
+
+    fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        GltfMaterialDesc::textures_mut(self)
+    }
+}
+
 /// The material kind of a glTF material: the textured [`GltfMaterial`], inside a normal
 /// map and a mask where it has them.
-pub(crate) fn build(g: &GltfMaterialDesc, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
+fn build_gltf(g: &GltfMaterialDesc, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
     let base_color_texture = textures.optional_gltf(&g.base_color_texture)?;
     let factors = GltfPbr {
         base_color: g.base_color,
@@ -342,6 +364,42 @@ pub(crate) fn build(g: &GltfMaterialDesc, textures: &mut TextureCache) -> Result
     };
     let alpha = GltfAlpha { factor: g.base_alpha, texture: base_color_texture, cutoff };
     Ok(MaterialKind::Mask(MaskMaterial { opacity: Texture::GltfAlpha(Arc::new(alpha)), nested: Box::new(kind) }))
+}
+
+/// A glTF material's factors: the specification's ranges ([0, 1] but for the index of
+/// refraction and the attenuation distance), so that a BSDF never sees a value it has no
+/// meaning for.
+fn check_gltf(g: &GltfMaterialDesc) -> Result<(), String> {
+    checks::eta(g.ior)?;
+    for (name, c) in [
+        ("baseColorFactor", g.base_color),
+        ("specularColorFactor", g.specular_color),
+        ("sheenColorFactor", g.sheen_color),
+        ("attenuationColor", g.attenuation_color),
+    ] {
+        checks::color(c, name)?;
+    }
+    for (name, v) in [
+        ("alpha", g.base_alpha),
+        ("metallicFactor", g.metallic),
+        ("roughnessFactor", g.roughness),
+        ("specularFactor", g.specular),
+        ("transmissionFactor", g.transmission),
+        ("clearcoatFactor", g.clearcoat),
+        ("clearcoatRoughnessFactor", g.clearcoat_roughness),
+        ("sheenRoughnessFactor", g.sheen_roughness),
+    ] {
+        if !(0.0..=1.0).contains(&v) {
+            return Err(format!("glTF material: {name} {v} must lie in [0, 1]"));
+        }
+    }
+    if !g.normal_scale.is_finite() {
+        return Err(format!("glTF material: normalTexture.scale {} must be finite", g.normal_scale));
+    }
+    if !(g.attenuation_distance > 0.0) {
+        return Err(format!("glTF material: attenuationDistance {} must be positive", g.attenuation_distance));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

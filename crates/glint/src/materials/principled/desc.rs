@@ -1,8 +1,9 @@
-//! The description of the principled BSDF (Mitsuba's `principled`). Scalar parameters that
+//! The description of the principled BSDF (Mitsuba's `principled`): its parameters, with
+//! Mitsuba's names and defaults (see [`PrincipledDesc::default`]). Scalar parameters that
 //! Mitsuba accepts as textures are [`TextureDesc`]s here, read as the luminance of the
 //! colour they give (Mitsuba's `eval_1`).
 
-use super::TextureDesc;
+use crate::describe::TextureDesc;
 use crate::math::Rgb;
 use serde::{Deserialize, Serialize};
 
