@@ -21,6 +21,7 @@ mod integrator;
 pub mod limits;
 mod medium;
 mod sampling;
+pub mod slots;
 pub use aov::Aov;
 pub use camera::{CropWindow, FovAxis, Projection};
 pub use gltf::{GltfTextureDesc, GltfWrap};

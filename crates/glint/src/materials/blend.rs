@@ -19,6 +19,7 @@
 use super::{Bsdf, MaterialKind, ScalarTexture, Shade, TextureCache, TexturePoint};
 use super::{Describe, MaterialModel};
 use crate::bsdf::{BsdfSample, Scatter};
+use crate::describe::slots::{texture_slot, Slot};
 use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::math::{Rgb, Vec3};
@@ -201,6 +202,13 @@ impl Describe for BlendDesc {
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         let parts = [&mut self.first, &mut self.second].into_iter().flat_map(|p| p.model.textures_mut());
         std::iter::once(&mut self.weight).chain(parts).collect()
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        // A blend's parts are not editable one by one (yet).
+        let mut out = Vec::new();
+        texture_slot("weight", &mut self.weight, &mut out);
+        out
     }
 }
 

@@ -8,6 +8,7 @@
 
 use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_conductor, reflect_local, BsdfSample, Microfacet, Scatter};
+use crate::describe::slots::{roughness_slots, Slot};
 use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3};
@@ -147,6 +148,16 @@ impl Describe for ConductorDesc {
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         self.roughness.as_mut().map_or(Vec::new(), Roughness::textures_mut)
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        let mut out = vec![
+            ("eta", Slot::Color(&mut self.eta)),
+            ("k", Slot::Color(&mut self.k)),
+            ("specular", Slot::Color(&mut self.specular)),
+        ];
+        roughness_slots(&mut self.roughness, &mut out);
+        out
     }
 }
 

@@ -10,6 +10,7 @@
 use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{eval_rough_dielectric, pdf_rough_dielectric, sample_rough_dielectric};
 use crate::bsdf::{fresnel_dielectric, reflect_local, refract_local, BsdfSample, Microfacet, Scatter};
+use crate::describe::slots::{roughness_slots, Slot};
 use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3};
@@ -188,6 +189,16 @@ impl Describe for DielectricDesc {
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         self.roughness.as_mut().map_or(Vec::new(), Roughness::textures_mut)
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        let mut out = vec![
+            ("eta", Slot::Float(&mut self.eta)),
+            ("reflect", Slot::Color(&mut self.reflect)),
+            ("transmit", Slot::Color(&mut self.transmit)),
+        ];
+        roughness_slots(&mut self.roughness, &mut out);
+        out
     }
 }
 

@@ -5,6 +5,7 @@
 
 use super::{Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{BsdfSample, Scatter};
+use crate::describe::slots::{texture_slot, Slot};
 use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::math::{Rgb, Vec3, INV_PI};
@@ -90,6 +91,12 @@ impl Describe for DiffuseDesc {
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         vec![&mut self.reflectance]
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        let mut out = Vec::new();
+        texture_slot("reflectance", &mut self.reflectance, &mut out);
+        out
     }
 }
 

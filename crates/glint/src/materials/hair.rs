@@ -17,6 +17,7 @@
 
 use super::{Bsdf, Describe, MaterialKind, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, BsdfSample, Scatter};
+use crate::describe::slots::Slot;
 use crate::describe::{checks, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3, PI};
@@ -379,6 +380,10 @@ impl Describe for HairDesc {
     }
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+        Vec::new()
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
         Vec::new()
     }
 }

@@ -63,6 +63,7 @@ pub use texture::{Bitmap, ScalarTexture, Texture, TexturePoint};
 pub use texture_cache::TextureCache;
 
 use crate::bsdf::{BsdfSample, Scatter};
+use crate::describe::slots::Slot;
 use crate::describe::{self, checks, TextureDesc};
 use crate::error::{Error, SourceLoc};
 use crate::math::{Rgb, Vec3};
@@ -87,6 +88,10 @@ pub trait Describe {
     fn textures(&self) -> Vec<&TextureDesc>;
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc>;
+
+    /// The parameters a session may edit in place (the Python API's `traverse`), named as
+    /// `materials.NAME.` followed by the name given here.
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)>;
 }
 
 /// What every built material answers. No method has a default, so that a new material
@@ -149,6 +154,11 @@ macro_rules! materials {
             /// See [`Describe::textures_mut`].
             pub fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
                 match self { $(MaterialModel::$variant(d) => Describe::textures_mut(d),)+ }
+            }
+
+            /// See [`Describe::slots`].
+            pub fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+                match self { $(MaterialModel::$variant(d) => Describe::slots(d),)+ }
             }
         }
 

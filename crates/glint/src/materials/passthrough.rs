@@ -9,6 +9,7 @@
 
 use super::{Bsdf, Describe, MaterialKind, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{BsdfSample, Scatter};
+use crate::describe::slots::Slot;
 use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::math::{Rgb, Vec3};
@@ -105,6 +106,10 @@ macro_rules! unit_describe {
             }
 
             fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+                Vec::new()
+            }
+
+            fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
                 Vec::new()
             }
         }

@@ -7,6 +7,7 @@
 
 use super::{Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{reflect_local, BsdfSample, Scatter};
+use crate::describe::slots::{texture_slot, Slot};
 use crate::describe::{checks, TextureDesc};
 use crate::error::Error;
 use crate::math::{Frame, Rgb, Vec3, INV_PI, PI};
@@ -125,6 +126,14 @@ impl Describe for PhongDesc {
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         vec![&mut self.kd]
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        let mut out = Vec::new();
+        texture_slot("kd", &mut self.kd, &mut out);
+        out.push(("ks", Slot::Color(&mut self.ks)));
+        out.push(("exponent", Slot::Float(&mut self.exponent)));
+        out
     }
 }
 

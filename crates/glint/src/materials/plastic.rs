@@ -15,6 +15,7 @@
 
 use super::{constant_microfacet, Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, reflect_local, BsdfSample, Microfacet, Scatter};
+use crate::describe::slots::{roughness_slots, texture_slot, Slot};
 use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3, INV_PI};
@@ -319,6 +320,15 @@ impl Describe for PlasticDesc {
         let mut textures = vec![&mut self.diffuse];
         textures.extend(self.roughness.as_mut().map_or(Vec::new(), Roughness::textures_mut));
         textures
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        let mut out = Vec::new();
+        texture_slot("diffuse", &mut self.diffuse, &mut out);
+        out.push(("specular", Slot::Color(&mut self.specular)));
+        out.push(("eta", Slot::Float(&mut self.eta)));
+        roughness_slots(&mut self.roughness, &mut out);
+        out
     }
 }
 

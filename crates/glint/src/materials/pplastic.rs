@@ -11,6 +11,7 @@
 
 use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, BsdfSample, Microfacet, Scatter};
+use crate::describe::slots::{roughness_value_slots, texture_slot, Slot};
 use crate::describe::{checks, Roughness, TextureDesc};
 use crate::error::Error;
 use crate::math::{Rgb, Vec3, INV_PI};
@@ -119,6 +120,15 @@ impl Describe for PPlasticDesc {
         let mut textures = vec![&mut self.diffuse];
         textures.extend(self.roughness.textures_mut());
         textures
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        let mut out = Vec::new();
+        texture_slot("diffuse", &mut self.diffuse, &mut out);
+        out.push(("specular", Slot::Color(&mut self.specular)));
+        out.push(("eta", Slot::Float(&mut self.eta)));
+        roughness_value_slots(&mut self.roughness, &mut out);
+        out
     }
 }
 

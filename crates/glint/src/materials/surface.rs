@@ -4,6 +4,7 @@
 
 use super::{Black, Bsdf};
 use super::{Describe, Material, MaterialKind, MaterialModel, Shade, Texture, TextureCache, TexturePoint};
+use crate::describe::slots::{texture_slot, Slot};
 use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::math::Rgb;
@@ -82,7 +83,7 @@ fn wrap(
 /// The wrapper description `$desc` of texture field `$tex`, built as `$built`, with `$check`
 /// its own parameters' check beside the nested material's.
 macro_rules! wrapper_describe {
-    ($desc:ty, $tex:ident, $built:ident { $($extra:ident),* }, $check:expr) => {
+    ($desc:ty, $tex:ident, $built:ident { $($extra:ident),* }, $check:expr, $slots:expr) => {
         impl Describe for $desc {
             type Built = $built;
 
@@ -104,19 +105,40 @@ macro_rules! wrapper_describe {
             fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
                 std::iter::once(&mut self.$tex).chain(self.nested.textures_mut()).collect()
             }
+
+            fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+                let slots: fn(&mut $desc) -> Vec<(&'static str, Slot<'_>)> = $slots;
+                slots(self)
+            }
         }
     };
 }
 
-wrapper_describe!(NormalMapDesc, normals, NormalMapMaterial {}, |_| Ok(()));
-wrapper_describe!(MaskDesc, opacity, MaskMaterial {}, |_| Ok(()));
-wrapper_describe!(BumpMapDesc, height, BumpMapMaterial { scale }, |d| {
-    if d.scale.is_finite() {
-        Ok(())
-    } else {
-        Err(format!("bump map scale {} must be finite", d.scale))
-    }
+// The wrapped material's parameters, a bump map's scale and a mask's constant opacity.
+wrapper_describe!(NormalMapDesc, normals, NormalMapMaterial {}, |_| Ok(()), |d| d.nested.slots());
+wrapper_describe!(MaskDesc, opacity, MaskMaterial {}, |_| Ok(()), |d| {
+    let mut out = Vec::new();
+    texture_slot("opacity", &mut d.opacity, &mut out);
+    out.extend(d.nested.slots());
+    out
 });
+wrapper_describe!(
+    BumpMapDesc,
+    height,
+    BumpMapMaterial { scale },
+    |d| {
+        if d.scale.is_finite() {
+            Ok(())
+        } else {
+            Err(format!("bump map scale {} must be finite", d.scale))
+        }
+    },
+    |d| {
+        let mut out = vec![("bump_scale", Slot::Float(&mut d.scale))];
+        out.extend(d.nested.slots());
+        out
+    }
+);
 
 /// The wrappers answer as black, non-transmissive surfaces: the integrators ask the nested
 /// material ([`MaterialKind::base`]).

@@ -14,13 +14,10 @@
 
 use super::Session;
 use crate::assemble::{patch_appearance, BuildCounters};
-use crate::describe::{Emission, LightKind, Matrix4, Roughness, ScalarTexture, TextureDesc};
+use crate::describe::slots::Slot;
+use crate::describe::{Emission, LightKind, Matrix4, TextureDesc};
 use crate::error::Error;
-use crate::materials::{
-    BlackDesc, BumpMapDesc, ConductorDesc, DielectricDesc, DiffuseDesc, MaskDesc, NormalMapDesc, NullDesc,
-    PPlasticDesc, PhongDesc, PlasticDesc,
-};
-use crate::materials::{MaterialModel, SceneDesc};
+use crate::materials::SceneDesc;
 use crate::math::Rgb;
 use std::sync::Arc;
 
@@ -47,15 +44,6 @@ impl ParamValue {
 pub struct Param {
     pub name: String,
     pub value: ParamValue,
-}
-
-/// A mutable place in the description that a parameter names.
-enum Slot<'a> {
-    Float(&'a mut f32),
-    Color(&'a mut Rgb),
-    Matrix(&'a mut Matrix4),
-    /// The camera's transform, which may be unset (the bounds are framed).
-    OptionalMatrix(&'a mut Option<Matrix4>),
 }
 
 impl Slot<'_> {
@@ -92,88 +80,6 @@ enum Effect {
     Transform(usize),
 }
 
-fn roughness_slots<'a>(r: &'a mut Option<Roughness>, out: &mut Vec<(&'static str, Slot<'a>)>) {
-    if let Some(r) = r {
-        roughness_value_slots(r, out);
-    }
-}
-
-/// The constant roughness values (textured ones are not edited in place).
-fn roughness_value_slots<'a>(r: &'a mut Roughness, out: &mut Vec<(&'static str, Slot<'a>)>) {
-    if let ScalarTexture::Value(a) = &mut r.alpha {
-        out.push(("alpha", Slot::Float(a)));
-    }
-    if let Some(ScalarTexture::Value(a)) = &mut r.alpha_v {
-        out.push(("alpha_v", Slot::Float(a)));
-    }
-}
-
-fn texture_slot<'a>(name: &'static str, t: &'a mut TextureDesc, out: &mut Vec<(&'static str, Slot<'a>)>) {
-    if let TextureDesc::Constant { color } = t {
-        out.push((name, Slot::Color(color)));
-    }
-}
-
-fn material_slots(m: &mut MaterialModel) -> Vec<(&'static str, Slot<'_>)> {
-    let mut out = Vec::new();
-    match m {
-        MaterialModel::Diffuse(DiffuseDesc { reflectance }) => texture_slot("reflectance", reflectance, &mut out),
-        MaterialModel::Phong(PhongDesc { kd, ks, exponent }) => {
-            texture_slot("kd", kd, &mut out);
-            out.push(("ks", Slot::Color(ks)));
-            out.push(("exponent", Slot::Float(exponent)));
-        }
-        MaterialModel::Conductor(ConductorDesc { eta, k, specular, roughness }) => {
-            out.push(("eta", Slot::Color(eta)));
-            out.push(("k", Slot::Color(k)));
-            out.push(("specular", Slot::Color(specular)));
-            roughness_slots(roughness, &mut out);
-        }
-        MaterialModel::Dielectric(DielectricDesc { eta, reflect, transmit, roughness, .. }) => {
-            out.push(("eta", Slot::Float(eta)));
-            out.push(("reflect", Slot::Color(reflect)));
-            out.push(("transmit", Slot::Color(transmit)));
-            roughness_slots(roughness, &mut out);
-        }
-        MaterialModel::Plastic(PlasticDesc { diffuse, specular, eta, roughness, .. }) => {
-            texture_slot("diffuse", diffuse, &mut out);
-            out.push(("specular", Slot::Color(specular)));
-            out.push(("eta", Slot::Float(eta)));
-            roughness_slots(roughness, &mut out);
-        }
-        MaterialModel::PPlastic(PPlasticDesc { diffuse, specular, eta, roughness }) => {
-            texture_slot("diffuse", diffuse, &mut out);
-            out.push(("specular", Slot::Color(specular)));
-            out.push(("eta", Slot::Float(eta)));
-            roughness_value_slots(roughness, &mut out);
-        }
-        MaterialModel::Black(BlackDesc {}) | MaterialModel::Null(NullDesc {}) | MaterialModel::Hair(_) => {}
-        // The wrapped material's parameters, and a mask's constant opacity.
-        MaterialModel::NormalMap(NormalMapDesc { nested, .. }) => return material_slots(nested),
-        MaterialModel::BumpMap(BumpMapDesc { scale, nested, .. }) => {
-            out.push(("bump_scale", Slot::Float(scale)));
-            out.extend(material_slots(nested));
-        }
-        MaterialModel::Mask(MaskDesc { opacity, nested }) => {
-            texture_slot("opacity", opacity, &mut out);
-            out.extend(material_slots(nested));
-        }
-        MaterialModel::Principled(p) => {
-            for (name, t) in crate::materials::PrincipledDesc::TEXTURE_NAMES.into_iter().zip(p.textures_mut()) {
-                texture_slot(name, t, &mut out);
-            }
-        }
-        MaterialModel::Gltf(g) => {
-            out.push(("base_color", Slot::Color(&mut g.base_color)));
-            out.push(("metallic", Slot::Float(&mut g.metallic)));
-            out.push(("roughness", Slot::Float(&mut g.roughness)));
-        }
-        // A blend's parts are not editable one by one (yet).
-        MaterialModel::Blend(b) => texture_slot("weight", &mut b.weight, &mut out),
-    }
-    out
-}
-
 fn light_slots(l: &mut LightKind) -> Vec<(&'static str, Slot<'_>)> {
     match l {
         LightKind::Point { intensity, .. } | LightKind::Spot { intensity, .. } => {
@@ -192,7 +98,7 @@ fn slots(desc: &mut SceneDesc) -> Vec<(String, Slot<'_>, Effect)> {
     let mut out = Vec::new();
     for m in &mut desc.materials {
         let name = m.name.clone();
-        for (field, slot) in material_slots(&mut m.model) {
+        for (field, slot) in m.model.slots() {
             out.push((format!("materials.{name}.{field}"), slot, Effect::Appearance));
         }
     }

@@ -11,6 +11,7 @@ pub use lobes::{sheen_albedo, sheen_albedo_quadrature, SHEEN_ALBEDO_TOLERANCE, S
 
 use super::{Black, Bsdf, Describe};
 use super::{MaskMaterial, MaterialKind, NormalMapMaterial, Shade, Texture, TextureCache, TexturePoint};
+use crate::describe::slots::Slot;
 use crate::describe::{checks, GltfWrap, TextureDesc};
 use crate::error::Error;
 use crate::io::gltf::RgbaImage;
@@ -315,6 +316,14 @@ impl Describe for GltfMaterialDesc {
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         GltfMaterialDesc::textures_mut(self)
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        vec![
+            ("base_color", Slot::Color(&mut self.base_color)),
+            ("metallic", Slot::Float(&mut self.metallic)),
+            ("roughness", Slot::Float(&mut self.roughness)),
+        ]
     }
 }
 

@@ -10,6 +10,7 @@ pub use desc::{principled_eta_of_specular, PrincipledDesc};
 use super::Bsdf;
 use super::Describe;
 use super::{MaterialKind, ScalarTexture, Shade, Texture, TextureCache, TexturePoint};
+use crate::describe::slots::{texture_slot, Slot};
 use crate::describe::{checks, TextureDesc};
 use crate::error::Error;
 use crate::math::Rgb;
@@ -52,6 +53,14 @@ impl Describe for PrincipledDesc {
 
     fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
         PrincipledDesc::textures_mut(self).into_iter().collect()
+    }
+
+    fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
+        let mut out = Vec::new();
+        for (name, t) in PrincipledDesc::TEXTURE_NAMES.into_iter().zip(PrincipledDesc::textures_mut(self)) {
+            texture_slot(name, t, &mut out);
+        }
+        out
     }
 }
 
