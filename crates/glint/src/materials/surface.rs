@@ -71,6 +71,15 @@ pub struct MaskDesc {
     pub nested: Box<MaterialModel>,
 }
 
+impl MaterialModel {
+    /// True for a normal or bump map, also inside masks: the readers accept one per
+    /// material.
+    pub fn perturbs_normals(&self) -> bool {
+        matches!(self, MaterialModel::NormalMap(_) | MaterialModel::BumpMap(_))
+            || matches!(self, MaterialModel::Mask(m) if m.nested.perturbs_normals())
+    }
+}
+
 /// A wrapper's texture and nested material, built.
 fn wrap(
     t: &TextureDesc,

@@ -7,7 +7,7 @@ use super::Reader;
 use crate::describe::TextureDesc;
 use crate::error::Error;
 use crate::materials::MaterialModel;
-use crate::materials::{BlackDesc, BumpMapDesc, MaskDesc, NormalMapDesc, NullDesc};
+use crate::materials::{BumpMapDesc, MaskDesc, NormalMapDesc};
 use crate::math::Rgb;
 
 impl<'a> Reader<'a> {
@@ -31,28 +31,7 @@ impl<'a> Reader<'a> {
     pub(super) fn surface_material(&mut self, el: &'a Element, ty: &str) -> Result<(MaterialModel, bool), Error> {
         let p = Props::new(el);
         let (nested, two_sided) = self.nested_bsdf(el, ty)?;
-        let perturbs = |m: &MaterialModel| -> bool {
-            let mut m = m;
-            loop {
-                match m {
-                    MaterialModel::NormalMap(_) | MaterialModel::BumpMap(_) => return true,
-                    MaterialModel::Mask(MaskDesc { nested, .. }) => m = nested,
-                    MaterialModel::Diffuse(_)
-                    | MaterialModel::Phong(_)
-                    | MaterialModel::Conductor(_)
-                    | MaterialModel::Dielectric(_)
-                    | MaterialModel::Plastic(_)
-                    | MaterialModel::Black(BlackDesc {})
-                    | MaterialModel::Null(NullDesc {})
-                    | MaterialModel::Principled(_)
-                    | MaterialModel::Blend(_)
-                    | MaterialModel::PPlastic(_)
-                    | MaterialModel::Hair(_)
-                    | MaterialModel::Gltf(_) => return false,
-                }
-            }
-        };
-        if ty != "mask" && perturbs(&nested) {
+        if ty != "mask" && nested.perturbs_normals() {
             return Err(el.err(format!("{ty}: a normal or bump map inside another one is not supported")));
         }
         if ty != "mask" {

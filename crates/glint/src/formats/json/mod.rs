@@ -1,8 +1,12 @@
 //! glint's native JSON scene format (documented in docs/scene-format.md), read into a
-//! [`SceneDesc`]. The serde structures below mirror the file; `read` turns them into the
+//! [`SceneDesc`]. The serde structures below mirror the file's scene structure (camera,
+//! film, shapes, lights); each material's object is read by its type's function in
+//! `materials`, straight into the material's description. `read` turns them into the
 //! description. Structural errors come from serde_json with their line and column; the
 //! others (an unknown material name, say) point at the offending value, found by its path
 //! in the document (`json_spans`), never by searching the text.
+
+mod materials;
 
 use super::json_spans::Spans;
 use crate::describe::{
@@ -12,13 +16,7 @@ use crate::describe::{
 };
 use crate::describe::{CropWindow, FovAxis, LightSelection, MicrofacetKind, PixelFilter, Projection, SamplerKind};
 use crate::error::{Error, SourceLoc};
-use crate::materials::conductor_preset;
-use crate::materials::{
-    principled_eta_of_specular, BumpMapDesc, ConductorDesc, DielectricDesc, DiffuseDesc, MaskDesc, NormalMapDesc,
-    NullDesc, PPlasticDesc, PhongDesc, PlasticDesc,
-};
-use crate::materials::{BlendDesc, BlendPartDesc, PrincipledDesc};
-use crate::materials::{MaterialDesc, MaterialModel, SceneDesc};
+use crate::materials::SceneDesc;
 use crate::math::{Mat4, Rgb, Transform, Vec3};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -34,7 +32,8 @@ struct JsonScene {
     #[serde(default)]
     sampler: JsonSampler,
     #[serde(default)]
-    materials: BTreeMap<String, JsonMaterial>,
+    /// Each material's object, read by its type's function in `materials`.
+    materials: BTreeMap<String, serde_json::Value>,
     #[serde(default)]
     meshes: BTreeMap<String, JsonMeshFile>,
     #[serde(default)]
@@ -200,129 +199,6 @@ enum JsonTexture {
         #[serde(default)]
         scale: Option<f32>,
     },
-}
-
-#[derive(Deserialize)]
-#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
-enum JsonMaterial {
-    Diffuse {
-        reflectance: JsonTexture,
-        #[serde(default)]
-        two_sided: Option<bool>,
-    },
-    Phong {
-        kd: JsonTexture,
-        #[serde(default)]
-        ks: Option<JsonColor>,
-        #[serde(default)]
-        exponent: Option<f32>,
-        #[serde(default)]
-        two_sided: Option<bool>,
-    },
-    /// A perfect mirror: conductor with reflectance 1 (or `specular`).
-    Mirror {
-        #[serde(default)]
-        specular: Option<JsonColor>,
-    },
-    Conductor {
-        #[serde(default)]
-        metal: Option<String>,
-        #[serde(default)]
-        eta: Option<JsonColor>,
-        #[serde(default)]
-        k: Option<JsonColor>,
-        #[serde(default)]
-        specular: Option<JsonColor>,
-        #[serde(default)]
-        alpha: Option<JsonTexture>,
-        #[serde(default)]
-        alpha_v: Option<JsonTexture>,
-        #[serde(default)]
-        distribution: Option<String>,
-    },
-    Dielectric {
-        #[serde(default)]
-        ior: Option<f32>,
-        #[serde(default)]
-        alpha: Option<JsonTexture>,
-        #[serde(default)]
-        alpha_v: Option<JsonTexture>,
-        #[serde(default)]
-        distribution: Option<String>,
-        #[serde(default)]
-        thin: bool,
-    },
-    Plastic {
-        diffuse: JsonTexture,
-        #[serde(default)]
-        ior: Option<f32>,
-        #[serde(default)]
-        alpha: Option<f32>,
-        #[serde(default)]
-        distribution: Option<String>,
-        #[serde(default)]
-        nonlinear: bool,
-    },
-    /// Mitsuba's `pplastic` as its RGB variants render it.
-    Pplastic {
-        diffuse: JsonTexture,
-        #[serde(default)]
-        specular: Option<JsonColor>,
-        #[serde(default)]
-        ior: Option<f32>,
-        #[serde(default)]
-        alpha: Option<JsonTexture>,
-        #[serde(default)]
-        alpha_v: Option<JsonTexture>,
-        #[serde(default)]
-        distribution: Option<String>,
-    },
-    /// Mitsuba's `polarizer` on unpolarized light: passes half of `transmittance`.
-    Polarizer {
-        #[serde(default)]
-        transmittance: Option<JsonColor>,
-    },
-    /// `material` shaded with a tangent-space normal map.
-    NormalMap { normals: JsonTexture, material: Box<JsonMaterial> },
-    /// `material` shaded with the normals of `scale` times a height texture.
-    BumpMap {
-        height: JsonTexture,
-        #[serde(default)]
-        scale: Option<f32>,
-        material: Box<JsonMaterial>,
-    },
-    /// `material` where opaque; light passes through with probability 1 - opacity.
-    Mask { opacity: JsonTexture, material: Box<JsonMaterial> },
-    /// Lets light through unchanged: a medium's boundary.
-    Null {},
-    /// Mitsuba's principled BSDF; every key optional, with Mitsuba's defaults.
-    Principled(Box<JsonPrincipled>),
-    /// (1 - weight) · first + weight · second.
-    Blend {
-        weight: JsonTexture,
-        materials: Box<[JsonMaterial; 2]>,
-        #[serde(default)]
-        two_sided: Option<bool>,
-    },
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct JsonPrincipled {
-    base_color: Option<JsonTexture>,
-    roughness: Option<JsonTexture>,
-    anisotropic: Option<JsonTexture>,
-    metallic: Option<JsonTexture>,
-    spec_trans: Option<JsonTexture>,
-    ior: Option<f32>,
-    specular: Option<f32>,
-    spec_tint: Option<JsonTexture>,
-    sheen: Option<JsonTexture>,
-    sheen_tint: Option<JsonTexture>,
-    flatness: Option<JsonTexture>,
-    clearcoat: Option<JsonTexture>,
-    clearcoat_gloss: Option<JsonTexture>,
-    two_sided: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -560,198 +436,6 @@ fn roughness(
     Ok(Some(Roughness { distribution, alpha, alpha_v }))
 }
 
-fn material_of(ctx: &Ctx, name: &str, m: &JsonMaterial) -> Result<MaterialDesc, Error> {
-    let at = format!("materials/{name}");
-    let (model, two_sided) = material_model_of(ctx, name, &at, m)?;
-    Ok(MaterialDesc { name: name.to_string(), model, two_sided, loc: ctx.loc(&at) })
-}
-
-/// A material's model and whether it is two-sided; `at` is its JSON path.
-fn material_model_of(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(MaterialModel, bool), Error> {
-    let at = at.to_string();
-    let nested = |inner: &JsonMaterial| -> Result<(Box<MaterialModel>, bool), Error> {
-        let (model, two_sided) = material_model_of(ctx, name, &format!("{at}/material"), inner)?;
-        if matches!(model, MaterialModel::NormalMap(_) | MaterialModel::BumpMap(_))
-            && !matches!(m, JsonMaterial::Mask { .. })
-        {
-            return Err(
-                ctx.err(&at, format!("material '{name}': a normal or bump map inside another one is not supported"))
-            );
-        }
-        Ok((Box::new(model), two_sided))
-    };
-    Ok(match m {
-        JsonMaterial::NormalMap { normals, material } => {
-            let (nested, two_sided) = nested(material)?;
-            (
-                MaterialModel::NormalMap(NormalMapDesc {
-                    normals: texture_of(ctx, &format!("{at}/normals"), normals),
-                    nested,
-                }),
-                two_sided,
-            )
-        }
-        JsonMaterial::BumpMap { height, scale, material } => {
-            let (nested, two_sided) = nested(material)?;
-            let height = texture_of(ctx, &format!("{at}/height"), height);
-            (MaterialModel::BumpMap(BumpMapDesc { height, scale: scale.unwrap_or(1.0), nested }), two_sided)
-        }
-        JsonMaterial::Mask { opacity, material } => {
-            let (nested, two_sided) = nested(material)?;
-            (
-                MaterialModel::Mask(MaskDesc { opacity: texture_of(ctx, &format!("{at}/opacity"), opacity), nested }),
-                two_sided,
-            )
-        }
-        _ => material_plain(ctx, name, &at, m)?,
-    })
-}
-
-fn material_plain(ctx: &Ctx, name: &str, at: &str, m: &JsonMaterial) -> Result<(MaterialModel, bool), Error> {
-    let at = at.to_string();
-    Ok(match m {
-        JsonMaterial::Diffuse { reflectance, two_sided } => (
-            MaterialModel::Diffuse(DiffuseDesc {
-                reflectance: texture_of(ctx, &format!("{at}/reflectance"), reflectance),
-            }),
-            two_sided.unwrap_or(true),
-        ),
-        JsonMaterial::Phong { kd, ks, exponent, two_sided } => (
-            MaterialModel::Phong(PhongDesc {
-                kd: texture_of(ctx, &format!("{at}/kd"), kd),
-                ks: ks.map_or(Rgb::BLACK, |c| c.rgb()),
-                exponent: exponent.unwrap_or(32.0),
-            }),
-            two_sided.unwrap_or(true),
-        ),
-        JsonMaterial::Mirror { specular } => (
-            MaterialModel::Conductor(ConductorDesc {
-                eta: Rgb::BLACK,
-                k: Rgb::WHITE,
-                specular: specular.map_or(Rgb::WHITE, |c| c.rgb()),
-                roughness: None,
-            }),
-            true,
-        ),
-        JsonMaterial::Conductor { metal, eta, k, specular, alpha, alpha_v, distribution } => {
-            let (e, kk) = match (metal, eta, k) {
-                (Some(mname), None, None) => conductor_preset(mname).ok_or_else(|| {
-                    ctx.err(
-                        &format!("{at}/metal"),
-                        format!("unknown metal '{mname}' (Mitsuba's conductor presets, e.g. Au, Ag, Cu, Al, Cr)"),
-                    )
-                })?,
-                (None, Some(e), Some(k)) => (e.rgb(), k.rgb()),
-                (None, None, None) => (Rgb::BLACK, Rgb::WHITE),
-                _ => return Err(ctx.err(&at, format!("material '{name}': give either 'metal' or both 'eta' and 'k'"))),
-            };
-            let specular = specular.map_or(Rgb::WHITE, |c| c.rgb());
-            let roughness = roughness(ctx, &at, distribution, alpha, alpha_v)?;
-            (MaterialModel::Conductor(ConductorDesc { eta: e, k: kk, specular, roughness }), true)
-        }
-        JsonMaterial::Dielectric { ior, alpha, alpha_v, distribution, thin } => {
-            let eta = ior.unwrap_or(1.5);
-            let roughness = if *thin { None } else { roughness(ctx, &at, distribution, alpha, alpha_v)? };
-            (
-                MaterialModel::Dielectric(DielectricDesc {
-                    eta,
-                    reflect: Rgb::WHITE,
-                    transmit: Rgb::WHITE,
-                    roughness,
-                    thin: *thin,
-                }),
-                false,
-            )
-        }
-        JsonMaterial::Plastic { diffuse, ior, alpha, distribution, nonlinear } => (
-            MaterialModel::Plastic(PlasticDesc {
-                diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
-                specular: Rgb::WHITE,
-                eta: ior.unwrap_or(1.49),
-                // Plastics are isotropic with a constant roughness, as in Mitsuba.
-                roughness: roughness(
-                    ctx,
-                    &at,
-                    distribution,
-                    &alpha.map(|a| JsonTexture::Color(JsonColor::Grey(a))),
-                    &None,
-                )?,
-                nonlinear: *nonlinear,
-            }),
-            true,
-        ),
-        JsonMaterial::Null {} => (MaterialModel::Null(NullDesc {}), false),
-        JsonMaterial::Pplastic { diffuse, specular, ior, alpha, alpha_v, distribution } => {
-            // Mitsuba's defaults: Beckmann, alpha 0.1.
-            let alpha = alpha.clone().or(Some(JsonTexture::Color(JsonColor::Grey(0.1))));
-            let name = distribution.clone().or(Some("beckmann".into()));
-            let roughness = roughness(ctx, &at, &name, &alpha, alpha_v)?
-                .ok_or_else(|| ctx.err(&format!("{at}/alpha"), "pplastic needs a positive alpha"))?;
-            (
-                MaterialModel::PPlastic(PPlasticDesc {
-                    diffuse: texture_of(ctx, &format!("{at}/diffuse"), diffuse),
-                    specular: specular.map_or(Rgb::WHITE, |c| c.rgb()),
-                    eta: ior.unwrap_or(1.49),
-                    roughness,
-                }),
-                true,
-            )
-        }
-        JsonMaterial::Polarizer { transmittance } => (
-            MaterialModel::Dielectric(DielectricDesc {
-                eta: 1.0,
-                reflect: Rgb::BLACK,
-                transmit: transmittance.map_or(Rgb::WHITE, |c| c.rgb()) * 0.5,
-                roughness: None,
-                thin: true,
-            }),
-            false,
-        ),
-        JsonMaterial::Principled(p) => principled_of(ctx, &at, p)?,
-        JsonMaterial::Blend { weight, materials, two_sided } => {
-            let part = |i: usize| -> Result<Box<BlendPartDesc>, Error> {
-                let m = material_of(ctx, &format!("{name}/materials/{i}"), &materials[i])?;
-                Ok(Box::new(BlendPartDesc { model: m.model, two_sided: m.two_sided }))
-            };
-            let weight = texture_of(ctx, &format!("{at}/weight"), weight);
-            (MaterialModel::Blend(BlendDesc { weight, first: part(0)?, second: part(1)? }), two_sided.unwrap_or(true))
-        }
-        JsonMaterial::NormalMap { .. } | JsonMaterial::BumpMap { .. } | JsonMaterial::Mask { .. } => {
-            return material_model_of(ctx, name, &at, m)
-        }
-    })
-}
-
-fn principled_of(ctx: &Ctx, at: &str, p: &JsonPrincipled) -> Result<(MaterialModel, bool), Error> {
-    let d = PrincipledDesc::default();
-    let tex = |key: &str, t: &Option<JsonTexture>, default: TextureDesc| match t {
-        Some(t) => texture_of(ctx, &format!("{at}/{key}"), t),
-        None => default,
-    };
-    let eta = match (p.ior, p.specular) {
-        (Some(_), Some(_)) => return Err(ctx.err(at, "principled: give either 'ior' or 'specular', not both")),
-        (Some(ior), None) => ior,
-        (None, Some(s)) => principled_eta_of_specular(s),
-        (None, None) => d.eta,
-    };
-    let desc = PrincipledDesc {
-        base_color: tex("base_color", &p.base_color, d.base_color.clone()),
-        roughness: tex("roughness", &p.roughness, d.roughness.clone()),
-        anisotropic: tex("anisotropic", &p.anisotropic, d.anisotropic.clone()),
-        metallic: tex("metallic", &p.metallic, d.metallic.clone()),
-        spec_trans: tex("spec_trans", &p.spec_trans, d.spec_trans.clone()),
-        eta,
-        spec_tint: tex("spec_tint", &p.spec_tint, d.spec_tint.clone()),
-        sheen: tex("sheen", &p.sheen, d.sheen.clone()),
-        sheen_tint: tex("sheen_tint", &p.sheen_tint, d.sheen_tint.clone()),
-        flatness: tex("flatness", &p.flatness, d.flatness.clone()),
-        clearcoat: tex("clearcoat", &p.clearcoat, d.clearcoat.clone()),
-        clearcoat_gloss: tex("clearcoat_gloss", &p.clearcoat_gloss, d.clearcoat_gloss.clone()),
-        ..d
-    };
-    Ok((MaterialModel::Principled(desc), p.two_sided.unwrap_or(true)))
-}
-
 /// Reads a JSON scene (`text` is the file's contents) into a description.
 pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -793,7 +477,7 @@ pub fn read(path: &Path, text: &str) -> Result<SceneDesc, Error> {
     desc.sampler = sampler_of(&ctx, &file.sampler)?;
 
     for (name, m) in &file.materials {
-        desc.materials.push(material_of(&ctx, name, m)?);
+        desc.materials.push(materials::material_of(&ctx, name, m)?);
     }
     for (name, m) in &file.meshes {
         desc.meshes.push(MeshFileDesc {

@@ -1,0 +1,297 @@
+//! The JSON format's materials: one reader function per material `type`, listed in
+//! [`READERS`], each reading its keys from the material's object straight into the
+//! material's description (`materials::*Desc`) and its sidedness. A key a type does not read
+//! is refused, pointing at it; so is a value of the wrong shape.
+
+use super::{roughness, texture_of, Ctx, JsonColor, JsonTexture};
+use crate::describe::{Roughness, TextureDesc};
+use crate::error::Error;
+use crate::materials::{
+    conductor_preset, principled_eta_of_specular, BlendDesc, BlendPartDesc, BumpMapDesc, ConductorDesc, DielectricDesc,
+    DiffuseDesc, MaskDesc, MaterialDesc, MaterialModel, NormalMapDesc, NullDesc, PPlasticDesc, PhongDesc, PlasticDesc,
+    PrincipledDesc,
+};
+use crate::math::Rgb;
+use serde::de::DeserializeOwned;
+use serde_json::{Map, Value};
+
+/// A material's description and whether it scatters on both faces.
+type Read = (MaterialModel, bool);
+
+/// Reads one material type from its keys.
+type Reader = fn(&mut Keys) -> Result<Read, Error>;
+
+/// Every material type the JSON format names, with its reader.
+const READERS: &[(&str, Reader)] = &[
+    ("diffuse", diffuse),
+    ("phong", phong),
+    ("mirror", mirror),
+    ("conductor", conductor),
+    ("dielectric", dielectric),
+    ("plastic", plastic),
+    ("pplastic", pplastic),
+    ("polarizer", polarizer),
+    ("principled", principled),
+    ("blend", blend),
+    ("normalmap", normal_map),
+    ("bumpmap", bump_map),
+    ("mask", mask),
+    ("null", null),
+];
+
+/// The material called `name`, from its JSON object.
+pub(super) fn material_of(ctx: &Ctx, name: &str, value: &Value) -> Result<MaterialDesc, Error> {
+    let at = format!("materials/{name}");
+    let (model, two_sided) = read_material(ctx, name, &at, value)?;
+    Ok(MaterialDesc { name: name.to_string(), model, two_sided, loc: ctx.loc(&at) })
+}
+
+/// A material object at document path `at` (of the material called `name`).
+fn read_material(ctx: &Ctx, name: &str, at: &str, value: &Value) -> Result<Read, Error> {
+    let Some(object) = value.as_object() else {
+        return Err(ctx.err(at, format!("material '{name}' must be an object with a \"type\"")));
+    };
+    let types = || READERS.iter().map(|(t, _)| *t).collect::<Vec<_>>().join(", ");
+    let ty = match object.get("type") {
+        Some(Value::String(t)) => t.as_str(),
+        _ => return Err(ctx.err(at, format!("material '{name}' needs a \"type\" (one of {})", types()))),
+    };
+    let Some((_, reader)) = READERS.iter().find(|(t, _)| *t == ty) else {
+        return Err(
+            ctx.err(&format!("{at}/type"), format!("material '{name}': unknown type '{ty}' (one of {})", types()))
+        );
+    };
+    let mut keys = Keys { ctx, name, at: at.to_string(), ty, object, asked: vec!["type"] };
+    let read = reader(&mut keys)?;
+    keys.finish()?;
+    Ok(read)
+}
+
+/// A material object's keys, read by name; remembers which were asked for, so that the rest
+/// can be refused.
+struct Keys<'a> {
+    ctx: &'a Ctx<'a>,
+    name: &'a str,
+    at: String,
+    ty: &'a str,
+    object: &'a Map<String, Value>,
+    asked: Vec<&'static str>,
+}
+
+impl Keys<'_> {
+    fn path(&self, key: &str) -> String {
+        format!("{}/{key}", self.at)
+    }
+
+    /// An error about the material as a whole.
+    fn err(&self, msg: impl std::fmt::Display) -> Error {
+        self.ctx.err(&self.at, format!("material '{}': {msg}", self.name))
+    }
+
+    /// The value of `key`, if given, as a `T`.
+    fn get<T: DeserializeOwned>(&mut self, key: &'static str) -> Result<Option<T>, Error> {
+        self.asked.push(key);
+        let Some(v) = self.object.get(key) else { return Ok(None) };
+        T::deserialize(v)
+            .map(Some)
+            .map_err(|e| self.ctx.err(&self.path(key), format!("material '{}': '{key}': {e}", self.name)))
+    }
+
+    fn texture(&mut self, key: &'static str) -> Result<Option<TextureDesc>, Error> {
+        let t: Option<JsonTexture> = self.get(key)?;
+        Ok(t.map(|t| texture_of(self.ctx, &self.path(key), &t)))
+    }
+
+    fn required_texture(&mut self, key: &'static str) -> Result<TextureDesc, Error> {
+        self.texture(key)?.ok_or_else(|| self.err(format!("{} needs '{key}'", self.ty)))
+    }
+
+    fn color(&mut self, key: &'static str) -> Result<Option<Rgb>, Error> {
+        Ok(self.get::<JsonColor>(key)?.map(JsonColor::rgb))
+    }
+
+    /// The roughness of `alpha` (a number or a texture), `alpha_v` and `distribution`.
+    fn roughness(&mut self) -> Result<Option<Roughness>, Error> {
+        let (alpha, alpha_v) = (self.get("alpha")?, self.get("alpha_v")?);
+        let distribution = self.get("distribution")?;
+        roughness(self.ctx, &self.at, &distribution, &alpha, &alpha_v)
+    }
+
+    /// The nested material of `key`, at its own document path.
+    fn material(&mut self, key: &'static str) -> Result<Read, Error> {
+        self.asked.push(key);
+        let v = self.object.get(key).ok_or_else(|| self.err(format!("{} needs '{key}'", self.ty)))?;
+        read_material(self.ctx, self.name, &self.path(key), v)
+    }
+
+    /// Refuses every key no reader asked for.
+    fn finish(&self) -> Result<(), Error> {
+        let Some(key) = self.object.keys().find(|k| !self.asked.contains(&k.as_str())) else { return Ok(()) };
+        let known = self.asked[1..].join(", ");
+        Err(self.ctx.err(
+            &self.path(key),
+            format!("material '{}': unknown key '{key}' for type '{}' (it reads {known})", self.name, self.ty),
+        ))
+    }
+}
+
+fn diffuse(k: &mut Keys) -> Result<Read, Error> {
+    let reflectance = k.required_texture("reflectance")?;
+    Ok((DiffuseDesc { reflectance }.into(), k.get("two_sided")?.unwrap_or(true)))
+}
+
+fn phong(k: &mut Keys) -> Result<Read, Error> {
+    let kd = k.required_texture("kd")?;
+    let ks = k.color("ks")?.unwrap_or(Rgb::BLACK);
+    let exponent = k.get("exponent")?.unwrap_or(32.0);
+    Ok((PhongDesc { kd, ks, exponent }.into(), k.get("two_sided")?.unwrap_or(true)))
+}
+
+/// A perfect mirror: a conductor of reflectance 1 (or `specular`).
+fn mirror(k: &mut Keys) -> Result<Read, Error> {
+    let specular = k.color("specular")?.unwrap_or(Rgb::WHITE);
+    Ok((ConductorDesc { eta: Rgb::BLACK, k: Rgb::WHITE, specular, roughness: None }.into(), true))
+}
+
+fn conductor(k: &mut Keys) -> Result<Read, Error> {
+    let (metal, eta, kk) = (k.get::<String>("metal")?, k.color("eta")?, k.color("k")?);
+    let (eta, kk) = match (metal, eta, kk) {
+        (Some(name), None, None) => conductor_preset(&name).ok_or_else(|| {
+            k.ctx.err(
+                &k.path("metal"),
+                format!("unknown metal '{name}' (Mitsuba's conductor presets, e.g. Au, Ag, Cu, Al, Cr)"),
+            )
+        })?,
+        (None, Some(e), Some(kk)) => (e, kk),
+        (None, None, None) => (Rgb::BLACK, Rgb::WHITE),
+        _ => return Err(k.err("give either 'metal' or both 'eta' and 'k'")),
+    };
+    let specular = k.color("specular")?.unwrap_or(Rgb::WHITE);
+    let roughness = k.roughness()?;
+    Ok((ConductorDesc { eta, k: kk, specular, roughness }.into(), true))
+}
+
+fn dielectric(k: &mut Keys) -> Result<Read, Error> {
+    let eta = k.get("ior")?.unwrap_or(1.5);
+    let thin = k.get("thin")?.unwrap_or(false);
+    // A thin sheet is smooth: its roughness keys are read past, unchecked.
+    let roughness = if thin {
+        k.asked.extend(["alpha", "alpha_v", "distribution"]);
+        None
+    } else {
+        k.roughness()?
+    };
+    Ok((DielectricDesc { eta, reflect: Rgb::WHITE, transmit: Rgb::WHITE, roughness, thin }.into(), false))
+}
+
+fn plastic(k: &mut Keys) -> Result<Read, Error> {
+    let diffuse = k.required_texture("diffuse")?;
+    let eta = k.get("ior")?.unwrap_or(1.49);
+    // Plastics are isotropic with a constant roughness, as in Mitsuba.
+    let alpha = k.get::<f32>("alpha")?.map(|a| JsonTexture::Color(JsonColor::Grey(a)));
+    let distribution = k.get("distribution")?;
+    let roughness = roughness(k.ctx, &k.at, &distribution, &alpha, &None)?;
+    let nonlinear = k.get("nonlinear")?.unwrap_or(false);
+    Ok((PlasticDesc { diffuse, specular: Rgb::WHITE, eta, roughness, nonlinear }.into(), true))
+}
+
+/// Mitsuba's `pplastic` as its RGB variants render it (Mitsuba's defaults: Beckmann, alpha
+/// 0.1).
+fn pplastic(k: &mut Keys) -> Result<Read, Error> {
+    let diffuse = k.required_texture("diffuse")?;
+    let specular = k.color("specular")?.unwrap_or(Rgb::WHITE);
+    let eta = k.get("ior")?.unwrap_or(1.49);
+    let alpha = k.get("alpha")?.or(Some(JsonTexture::Color(JsonColor::Grey(0.1))));
+    let alpha_v = k.get("alpha_v")?;
+    let distribution = k.get::<String>("distribution")?.or(Some("beckmann".into()));
+    let roughness = roughness(k.ctx, &k.at, &distribution, &alpha, &alpha_v)?
+        .ok_or_else(|| k.ctx.err(&k.path("alpha"), "pplastic needs a positive alpha"))?;
+    Ok((PPlasticDesc { diffuse, specular, eta, roughness }.into(), true))
+}
+
+/// Mitsuba's `polarizer` on unpolarized light: passes half of `transmittance`.
+fn polarizer(k: &mut Keys) -> Result<Read, Error> {
+    let transmit = k.color("transmittance")?.unwrap_or(Rgb::WHITE) * 0.5;
+    Ok((DielectricDesc { eta: 1.0, reflect: Rgb::BLACK, transmit, roughness: None, thin: true }.into(), false))
+}
+
+/// Mitsuba's principled BSDF; every key optional, with Mitsuba's defaults.
+fn principled(k: &mut Keys) -> Result<Read, Error> {
+    let d = PrincipledDesc::default();
+    let (ior, specular) = (k.get("ior")?, k.get("specular")?);
+    let eta = match (ior, specular) {
+        (Some(_), Some(_)) => return Err(k.ctx.err(&k.at, "principled: give either 'ior' or 'specular', not both")),
+        (Some(ior), None) => ior,
+        (None, Some(s)) => principled_eta_of_specular(s),
+        (None, None) => d.eta,
+    };
+    let mut tex = |key: &'static str, default: &TextureDesc| -> Result<TextureDesc, Error> {
+        Ok(k.texture(key)?.unwrap_or_else(|| default.clone()))
+    };
+    let desc = PrincipledDesc {
+        base_color: tex("base_color", &d.base_color)?,
+        roughness: tex("roughness", &d.roughness)?,
+        anisotropic: tex("anisotropic", &d.anisotropic)?,
+        metallic: tex("metallic", &d.metallic)?,
+        spec_trans: tex("spec_trans", &d.spec_trans)?,
+        eta,
+        spec_tint: tex("spec_tint", &d.spec_tint)?,
+        sheen: tex("sheen", &d.sheen)?,
+        sheen_tint: tex("sheen_tint", &d.sheen_tint)?,
+        flatness: tex("flatness", &d.flatness)?,
+        clearcoat: tex("clearcoat", &d.clearcoat)?,
+        clearcoat_gloss: tex("clearcoat_gloss", &d.clearcoat_gloss)?,
+        ..d
+    };
+    Ok((desc.into(), k.get("two_sided")?.unwrap_or(true)))
+}
+
+/// (1 - weight) · first + weight · second, the two in `materials`.
+fn blend(k: &mut Keys) -> Result<Read, Error> {
+    let weight = k.required_texture("weight")?;
+    let parts: [Value; 2] = k.get("materials")?.ok_or_else(|| k.err("blend needs 'materials' (two of them)"))?;
+    let part = |i: usize| -> Result<Box<BlendPartDesc>, Error> {
+        let name = format!("{}/materials/{i}", k.name);
+        let (model, two_sided) = read_material(k.ctx, &name, &format!("materials/{name}"), &parts[i])?;
+        Ok(Box::new(BlendPartDesc { model, two_sided }))
+    };
+    let (first, second) = (part(0)?, part(1)?);
+    Ok((BlendDesc { weight, first, second }.into(), k.get("two_sided")?.unwrap_or(true)))
+}
+
+/// A wrapper's nested material, refused when it is itself a normal or bump map (a mask may
+/// hold one).
+fn nested(k: &mut Keys, may_perturb: bool) -> Result<(Box<MaterialModel>, bool), Error> {
+    let (model, two_sided) = k.material("material")?;
+    if !may_perturb && model.perturbs_normals() {
+        return Err(k.err("a normal or bump map inside another one is not supported"));
+    }
+    Ok((Box::new(model), two_sided))
+}
+
+/// `material` shaded with a tangent-space normal map.
+fn normal_map(k: &mut Keys) -> Result<Read, Error> {
+    let normals = k.required_texture("normals")?;
+    let (nested, two_sided) = nested(k, false)?;
+    Ok((NormalMapDesc { normals, nested }.into(), two_sided))
+}
+
+/// `material` shaded with the normals of `scale` times a height texture.
+fn bump_map(k: &mut Keys) -> Result<Read, Error> {
+    let height = k.required_texture("height")?;
+    let scale = k.get("scale")?.unwrap_or(1.0);
+    let (nested, two_sided) = nested(k, false)?;
+    Ok((BumpMapDesc { height, scale, nested }.into(), two_sided))
+}
+
+/// `material` where opaque; light passes through with probability 1 - opacity.
+fn mask(k: &mut Keys) -> Result<Read, Error> {
+    let opacity = k.required_texture("opacity")?;
+    let (nested, two_sided) = nested(k, true)?;
+    Ok((MaskDesc { opacity, nested }.into(), two_sided))
+}
+
+/// Lets light through unchanged: a medium's boundary.
+fn null(_k: &mut Keys) -> Result<Read, Error> {
+    Ok((NullDesc {}.into(), false))
+}
