@@ -17,6 +17,7 @@
 //! docs/rendering.md ("Adding a material") walks through it.
 
 mod blend;
+mod coated_diffuse;
 mod conductor;
 mod conductor_presets;
 mod dielectric;
@@ -34,6 +35,7 @@ mod surface;
 mod texture;
 mod texture_cache;
 pub use blend::{BlendBsdf, BlendDesc, BlendMaterial, BlendMaterialPart, BlendPart, BlendPartDesc};
+pub use coated_diffuse::{CoatedDiffuse, CoatedDiffuseDesc, CoatedDiffuseMaterial};
 pub use conductor::{Conductor, ConductorDesc, ConductorMaterial, RoughConductor};
 pub use dielectric::{
     Dielectric, DielectricDesc, DielectricMaterial, DielectricSurface, RoughDielectric, ThinDielectric,
@@ -292,6 +294,8 @@ materials! {
     Hair(HairDesc => HairBsdf) [Hair(HairBsdf)],
     /// A glTF 2.0 metallic-roughness material with the KHR extensions.
     Gltf(GltfMaterialDesc => GltfMaterial) [GltfPbr(GltfPbr)],
+    /// pbrt-v4's `coateddiffuse`: a diffuse base under a slab and a coating, by random walks.
+    CoatedDiffuse(CoatedDiffuseDesc => CoatedDiffuseMaterial) [CoatedDiffuse(CoatedDiffuse)],
 }
 
 impl MaterialModel {

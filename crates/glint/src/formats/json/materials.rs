@@ -7,9 +7,9 @@ use super::{roughness, texture_of, Ctx, JsonColor, JsonTexture};
 use crate::describe::{Roughness, TextureDesc};
 use crate::error::Error;
 use crate::materials::{
-    conductor_preset, principled_eta_of_specular, BlendDesc, BlendPartDesc, BumpMapDesc, ConductorDesc, DielectricDesc,
-    DiffuseDesc, MaskDesc, MaterialDesc, MaterialModel, NormalMapDesc, NullDesc, PPlasticDesc, PhongDesc, PlasticDesc,
-    PrincipledDesc,
+    conductor_preset, principled_eta_of_specular, BlendDesc, BlendPartDesc, BumpMapDesc, CoatedDiffuseDesc,
+    ConductorDesc, DielectricDesc, DiffuseDesc, MaskDesc, MaterialDesc, MaterialModel, NormalMapDesc, NullDesc,
+    PPlasticDesc, PhongDesc, PlasticDesc, PrincipledDesc,
 };
 use crate::math::Rgb;
 use serde::de::DeserializeOwned;
@@ -31,6 +31,7 @@ const READERS: &[(&str, Reader)] = &[
     ("plastic", plastic),
     ("pplastic", pplastic),
     ("polarizer", polarizer),
+    ("coateddiffuse", coated_diffuse),
     ("principled", principled),
     ("blend", blend),
     ("normalmap", normal_map),
@@ -213,6 +214,26 @@ fn pplastic(k: &mut Keys) -> Result<Read, Error> {
 fn polarizer(k: &mut Keys) -> Result<Read, Error> {
     let transmit = k.color("transmittance")?.unwrap_or(Rgb::WHITE) * 0.5;
     Ok((DielectricDesc { eta: 1.0, reflect: Rgb::BLACK, transmit, roughness: None, thin: true }.into(), false))
+}
+
+/// pbrt-v4's `coateddiffuse`, with pbrt-v4's defaults; `ior` is accepted for `eta`.
+fn coated_diffuse(k: &mut Keys) -> Result<Read, Error> {
+    let d = CoatedDiffuseDesc::default();
+    let (eta, ior) = (k.get("eta")?, k.get("ior")?);
+    if let (Some(_), Some(_)) = (eta, ior) {
+        return Err(k.err("give either 'eta' or 'ior', not both"));
+    }
+    let desc = CoatedDiffuseDesc {
+        reflectance: k.texture("reflectance")?.unwrap_or(d.reflectance),
+        roughness: k.get("roughness")?.unwrap_or(d.roughness),
+        thickness: k.get("thickness")?.unwrap_or(d.thickness),
+        eta: eta.or(ior).unwrap_or(d.eta),
+        albedo: k.color("albedo")?.unwrap_or(d.albedo),
+        g: k.get("g")?.unwrap_or(d.g),
+        max_depth: k.get("maxdepth")?.unwrap_or(d.max_depth),
+        n_samples: k.get("nsamples")?.unwrap_or(d.n_samples),
+    };
+    Ok((desc.into(), k.get("two_sided")?.unwrap_or(true)))
 }
 
 /// Mitsuba's principled BSDF; every key optional, with Mitsuba's defaults.
