@@ -131,18 +131,18 @@ fn smith_ggx1(v: Vec3, m: Vec3, alpha: f32) -> f32 {
     2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt())
 }
 
-fn schlick_weight(cos: f32) -> f32 {
+pub(crate) fn schlick_weight(cos: f32) -> f32 {
     let m = (1.0 - cos).clamp(0.0, 1.0);
     m * m * m * m * m
 }
 
-fn lerp(a: f32, b: f32, t: f32) -> f32 {
+pub(crate) fn lerp(a: f32, b: f32, t: f32) -> f32 {
     a * (1.0 - t) + b * t
 }
 
 /// Schlick's Fresnel with normal reflectance `r0` (per channel); inside a denser medium the
 /// transmitted cosine is used, as Mitsuba does.
-fn schlick(r0: Rgb, cos_i: f32, eta: f32) -> Rgb {
+pub(crate) fn schlick(r0: Rgb, cos_i: f32, eta: f32) -> Rgb {
     let outside = cos_i >= 0.0;
     let (eta_it, eta_ti) = if outside { (eta, 1.0 / eta) } else { (1.0 / eta, eta) };
     let w = if eta_it > 1.0 {
@@ -154,19 +154,40 @@ fn schlick(r0: Rgb, cos_i: f32, eta: f32) -> Rgb {
     r0.map(|r| lerp(w, 1.0, r))
 }
 
-fn schlick_r0(eta: f32) -> f32 {
+pub(crate) fn schlick_r0(eta: f32) -> f32 {
     ((eta - 1.0) / (eta + 1.0)).powi(2)
 }
 
 /// `base_color` over its luminance (white where it has none): the tint of `spec_tint` and
 /// `sheen_tint`.
-fn tint_of(base: Rgb) -> Rgb {
+pub(crate) fn tint_of(base: Rgb) -> Rgb {
     let lum = base.luminance();
     if lum > 0.0 {
         base / lum
     } else {
         Rgb::WHITE
     }
+}
+
+/// Burley's diffuse lobe without its albedo and 1/π: the diffuse and retro-reflection
+/// response, blended by `flatness` (when positive) with the Hanrahan-Krueger-like fake
+/// subsurface term flattened by roughness. `ci` and `co` are the absolute cosines of the
+/// light and view directions, `cos_d` the cosine between the light and the half vector.
+/// Shared by `principled` and `principledthin`, whose lobes are the same term for term.
+pub(crate) fn disney_diffuse(roughness: f32, flatness: f32, ci: f32, co: f32, cos_d: f32) -> f32 {
+    let (f_light, f_view) = (schlick_weight(ci), schlick_weight(co));
+    let f_diff = (1.0 - 0.5 * f_view) * (1.0 - 0.5 * f_light);
+    let rr = 2.0 * roughness * cos_d * cos_d;
+    let f_retro = rr * (f_light + f_view + f_light * f_view * (rr - 1.0));
+    let mut lobe = f_diff + f_retro;
+    if flatness > 0.0 {
+        // Hanrahan-Krueger-like fake subsurface, flattened by roughness.
+        let fss90 = rr / 2.0;
+        let fss = lerp(1.0, fss90, f_light) * lerp(1.0, fss90, f_view);
+        let f_ss = 1.25 * (fss * (1.0 / (ci + co) - 0.5) + 0.5);
+        lobe = lerp(lobe, f_ss, flatness);
+    }
+    lobe
 }
 
 /// Mitsuba's `*_sampling_rate` parameters: relative weights of the lobes when sampling.
@@ -231,7 +252,7 @@ pub fn principled_alphas(roughness: f32, anisotropic: f32) -> (f32, f32) {
 
 /// Whether the configuration of `m` with the two directions is a reflection (or, when
 /// `reflection` is false, a refraction) through that microfacet seen from `wo`'s side.
-fn compatible(m: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, reflection: bool) -> bool {
+pub(crate) fn compatible(m: Vec3, wo: Vec3, wi: Vec3, cos_o: f32, reflection: bool) -> bool {
     let ms = if cos_o < 0.0 { -m } else { m };
     if reflection {
         wo.dot(ms) > 0.0 && wi.dot(ms) > 0.0
@@ -339,19 +360,8 @@ impl Principled {
 
     fn diffuse_and_sheen(&self, wo: Vec3, wi: Vec3, wh: Vec3, brdf: f32) -> Rgb {
         let (ci, co) = (wi.z.abs(), wo.z.abs());
-        let (f_light, f_view) = (schlick_weight(ci), schlick_weight(co));
-        let f_diff = (1.0 - 0.5 * f_view) * (1.0 - 0.5 * f_light);
         let cos_d = wh.dot(wi);
-        let rr = 2.0 * self.roughness * cos_d * cos_d;
-        let f_retro = rr * (f_light + f_view + f_light * f_view * (rr - 1.0));
-        let mut lobe = f_diff + f_retro;
-        if self.flatness > 0.0 {
-            // Hanrahan-Krueger-like fake subsurface, flattened by roughness.
-            let fss90 = rr / 2.0;
-            let fss = lerp(1.0, fss90, f_light) * lerp(1.0, fss90, f_view);
-            let f_ss = 1.25 * (fss * (1.0 / (ci + co) - 0.5) + 0.5);
-            lobe = lerp(lobe, f_ss, self.flatness);
-        }
+        let lobe = disney_diffuse(self.roughness, self.flatness, ci, co, cos_d);
         let mut value = self.base_color * (brdf * ci * INV_PI * lobe);
         if self.sheen > 0.0 && 1.0 - self.metallic > 0.0 {
             let fd = schlick_weight(cos_d.abs());
