@@ -4,6 +4,7 @@
 mod bsdf;
 mod desc;
 
+pub(crate) use bsdf::{compatible, disney_diffuse, lerp, schlick, schlick_r0, schlick_weight, tint_of};
 pub use bsdf::{principled_alphas, AnisoGgx, Principled, PrincipledInputs, PrincipledRates};
 pub use desc::{principled_eta_of_specular, PrincipledDesc};
 
