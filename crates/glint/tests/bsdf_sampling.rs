@@ -9,7 +9,8 @@ use common::stats::{sidak, z_critical, FALSE_ALARM};
 use glint::bsdf::{Microfacet, MicrofacetKind};
 use glint::materials::{
     normal_map_frame, BlendBsdf, BlendPart, Bsdf, Conductor, Diffuse, GltfPbr, HairBsdf, PPlasticParams, Phong,
-    PlasticParams, Principled, PrincipledInputs, PrincipledRates, RoughConductor, RoughDielectric, ShadedBsdf,
+    PlasticParams, Principled, PrincipledInputs, PrincipledRates, PrincipledThin, PrincipledThinInputs,
+    PrincipledThinRates, RoughConductor, RoughDielectric, ShadedBsdf,
 };
 use glint::math::vec3;
 use glint::math::{rgb, Rgb};
@@ -147,6 +148,7 @@ fn cases() -> Vec<BsdfCase> {
         }
     }
     principled_and_blend_cases(&mut v);
+    principled_thin_cases(&mut v);
     hair_cases(&mut v);
     gltf_cases(&mut v);
     v
@@ -239,6 +241,62 @@ fn principled(f: impl FnOnce(&mut PrincipledInputs)) -> Bsdf {
     };
     f(&mut p);
     Bsdf::Principled(Principled::new(&p))
+}
+
+/// Mitsuba's principledthin defaults with `f` applied.
+fn principled_thin(f: impl FnOnce(&mut PrincipledThinInputs)) -> Bsdf {
+    let mut p = PrincipledThinInputs {
+        base_color: rgb(0.8, 0.4, 0.2),
+        roughness: 0.5,
+        anisotropic: 0.0,
+        spec_trans: 0.0,
+        eta: 1.5,
+        spec_tint: 0.0,
+        sheen: 0.0,
+        sheen_tint: 0.0,
+        flatness: 0.0,
+        diff_trans: 0.0,
+        rates: PrincipledThinRates::default(),
+    };
+    f(&mut p);
+    Bsdf::PrincipledThin(PrincipledThin::new(&p))
+}
+
+/// The thin sheet: both faces scatter alike (so each set is also seen from below), and both
+/// transmissions leave on the other side.
+fn principled_thin_cases(v: &mut Vec<BsdfCase>) {
+    for wo in [0.0, 60.0] {
+        v.push(case("principledthin defaults", principled_thin(|_| {}), wo, false));
+    }
+    let glossy = principled_thin(|p| {
+        (p.roughness, p.spec_trans, p.eta, p.spec_tint) = (0.4, 0.8, 1.33, 0.3);
+    });
+    for wo in [30.0, 80.0, 150.0] {
+        v.push(case("principledthin spec_trans 0.8", glossy.clone(), wo, false));
+    }
+    let aniso = principled_thin(|p| {
+        (p.roughness, p.anisotropic, p.spec_trans, p.sheen, p.sheen_tint) = (0.5, 0.7, 0.5, 0.8, 0.5);
+    });
+    for (theta, phi) in [(20.0, 30.0), (70.0, 120.0)] {
+        v.push(azimuth_case("principledthin anisotropic sheen", aniso.clone(), theta, phi));
+    }
+    let leaf = principled_thin(|p| (p.roughness, p.diff_trans, p.flatness) = (0.6, 1.5, 0.6));
+    for wo in [40.0, 130.0] {
+        v.push(case("principledthin diff_trans 1.5 flatness", leaf.clone(), wo, false));
+    }
+    let every = principled_thin(|p| {
+        (p.roughness, p.anisotropic, p.spec_trans, p.eta) = (0.45, 0.3, 0.4, 1.7);
+        (p.diff_trans, p.spec_tint, p.sheen, p.sheen_tint, p.flatness) = (1.0, 1.0, 0.3, 0.2, 0.4);
+        p.rates = PrincipledThinRates {
+            diffuse_reflectance: 0.5,
+            diffuse_transmittance: 2.0,
+            specular_reflectance: 1.5,
+            specular_transmittance: 1.0,
+        };
+    });
+    for (theta, phi) in [(45.0, 60.0), (160.0, 200.0)] {
+        v.push(azimuth_case("principledthin every lobe, rates", every.clone(), theta, phi));
+    }
 }
 
 fn blend(weight: f32, first: Bsdf, second: Bsdf, first_two_sided: bool) -> Bsdf {

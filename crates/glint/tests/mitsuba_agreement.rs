@@ -299,6 +299,13 @@ fn principled_bsdf_under_an_environment_map() {
     check("principled");
 }
 
+/// Mitsuba's `principledthin`: specular and diffuse transmission through thin spheres and a
+/// sheet, sheen, anisotropy, flatness, textured base_color, roughness and eta.
+#[test]
+fn principled_thin_bsdf_under_an_environment_map() {
+    check("principledthin");
+}
+
 #[test]
 fn blended_bsdfs_and_twosided_around_and_inside_a_blend() {
     check("blend");

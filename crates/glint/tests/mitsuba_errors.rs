@@ -248,3 +248,36 @@ fn sdfgrid_bad_files_and_parameters() {
     let p = write(&dir, "sdf-ok.xml", &sdf_scene(file));
     assert!(load(&p, &[], None).is_ok());
 }
+
+/// `principledthin`'s documented ranges: [0, 1], but `diff_trans` in [0, 2] and `eta`
+/// positive (a texture's values included); the limits themselves load.
+#[test]
+fn principledthin_parameter_ranges() {
+    let dir = scratch("principledthin-ranges");
+    let scene = |params: &str| {
+        format!(
+            "<scene version=\"3.0.0\">\n{SENSOR}\n<shape type=\"sphere\">\n <bsdf type=\"principledthin\">{params}</bsdf>\n</shape>\n</scene>\n"
+        )
+    };
+    for (params, wanted) in [
+        (r#"<float name="diff_trans" value="2.5"/>"#, "diff_trans (2.5, 2.5, 2.5) must lie in [0, 2]"),
+        (r#"<float name="spec_trans" value="1.2"/>"#, "spec_trans (1.2, 1.2, 1.2) must lie in [0, 1]"),
+        (r#"<float name="sheen" value="-0.1"/>"#, "colour (-0.1, -0.1, -0.1) must be finite and not negative"),
+        (
+            r#"<texture type="checkerboard" name="eta"><float name="color0" value="1.3"/><float name="color1" value="0"/></texture>"#,
+            "index of refraction 0 must be positive",
+        ),
+        (r#"<float name="specular_transmittance_sampling_rate" value="-1"/>"#, "must be finite and not negative"),
+    ] {
+        let e = error_of(&dir, "thin.xml", &scene(params));
+        assert!(e.contains("thin.xml:5") && e.contains(wanted), "{params}: {e}");
+    }
+    let ok = write(
+        &dir,
+        "thin-ok.xml",
+        &scene(
+            r#"<float name="diff_trans" value="2"/><float name="spec_trans" value="1"/><float name="eta" value="0.9"/>"#,
+        ),
+    );
+    load(&ok, &[], None).unwrap();
+}

@@ -79,6 +79,43 @@ fn open_box_in_environment() -> World {
     b.finish(cam, LightSelection::Power).unwrap()
 }
 
+/// The open box with a ball and a free-standing sheet of Mitsuba's `principledthin` made a
+/// white Lambertian transmitter (`diff_trans` 2, no specular transmission: the one setting
+/// of the model that keeps all energy): light crosses them from either face.
+fn open_box_with_thin_transmitters() -> World {
+    use glint::materials::PrincipledThinRates;
+    use glint::materials::{PrincipledThinMaterial, ScalarTexture};
+    let mut b = WorldBuilder::new(BvhSplit::Sah);
+    let white = diffuse(&mut b, "white", Rgb::WHITE);
+    let c = ScalarTexture::Constant;
+    let sheet = b.add_material(Material::new(
+        "sheet",
+        MaterialKind::PrincipledThin(PrincipledThinMaterial {
+            base_color: Texture::Constant(Rgb::WHITE),
+            roughness: c(0.5),
+            anisotropic: c(0.0),
+            spec_trans: c(0.0),
+            eta: c(1.5),
+            spec_tint: c(0.0),
+            sheen: c(0.0),
+            sheen_tint: c(0.0),
+            flatness: c(0.0),
+            diff_trans: c(2.0),
+            rates: PrincipledThinRates::default(),
+        }),
+        true,
+    ));
+    add_square(&mut b, vec3(0.0, -1.0, 0.0), 1, 1.0, 1.0, white, None);
+    add_square(&mut b, vec3(0.0, 0.0, -1.0), 2, 1.0, 1.0, white, None);
+    add_square(&mut b, vec3(-1.0, 0.0, 0.0), 0, 1.0, 1.0, white, None);
+    add_square(&mut b, vec3(1.0, 0.0, 0.0), 0, -1.0, 1.0, sheet, None);
+    add_square(&mut b, vec3(0.0, -0.3, 0.4), 2, 1.0, 0.5, sheet, None);
+    b.add_sphere(vec3(-0.3, -0.5, -0.3), 0.4, &Transform::IDENTITY, sheet, None, false).unwrap();
+    b.add_constant_environment(Rgb::splat(ENV));
+    let cam = camera(vec3(0.5, 3.0, 2.5), vec3(0.0, -0.4, 0.0), Vec3::Y, 45.0, SIZE, SIZE);
+    b.finish(cam, LightSelection::Power).unwrap()
+}
+
 /// Emission and albedo of the enclosure.
 const LE: f32 = 1.0;
 const ALBEDO: f32 = 0.5;
@@ -109,6 +146,11 @@ fn emitting_enclosure() -> World {
 #[test]
 fn albedo_one_objects_in_a_uniform_environment_look_like_the_environment() {
     check_all(&open_box_in_environment(), ENV as f64, 0.95, SPP);
+}
+
+#[test]
+fn thin_white_transmitters_in_a_uniform_environment_look_like_the_environment() {
+    check_all(&open_box_with_thin_transmitters(), ENV as f64, 0.95, SPP);
 }
 
 #[test]

@@ -30,6 +30,7 @@ mod phong;
 mod plastic;
 mod pplastic;
 mod principled;
+mod principled_thin;
 mod roughness;
 mod surface;
 mod texture;
@@ -55,6 +56,9 @@ pub use pplastic::{PPlasticDesc, PPlasticMaterial, PPlasticParams};
 pub use principled::{
     principled_alphas, principled_eta_of_specular, AnisoGgx, Principled, PrincipledDesc, PrincipledInputs,
     PrincipledMaterial, PrincipledRates,
+};
+pub use principled_thin::{
+    PrincipledThin, PrincipledThinDesc, PrincipledThinInputs, PrincipledThinMaterial, PrincipledThinRates,
 };
 pub use roughness::RoughnessMap;
 pub(crate) use roughness::{constant_microfacet, roughness_map};
@@ -286,6 +290,8 @@ materials! {
     Null(NullDesc => Null) [Null(Null)],
     /// Mitsuba's `principled` (Disney) BSDF.
     Principled(PrincipledDesc => PrincipledMaterial) [Principled(Principled)],
+    /// Mitsuba's `principledthin`: the Disney BSDF of a thin translucent sheet.
+    PrincipledThin(PrincipledThinDesc => PrincipledThinMaterial) [PrincipledThin(PrincipledThin)],
     /// Mitsuba's `blendbsdf`: a weighted mixture of two materials.
     Blend(BlendDesc => BlendMaterial) [Blend(BlendBsdf)],
     /// Mitsuba's `pplastic` as its unpolarized variants render it.

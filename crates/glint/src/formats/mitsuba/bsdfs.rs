@@ -13,6 +13,7 @@ use crate::error::Error;
 use crate::materials::conductor_preset;
 use crate::materials::{
     principled_eta_of_specular, BlendDesc, BlendPartDesc, MaterialDesc, MaterialModel, PrincipledDesc,
+    PrincipledThinDesc,
 };
 use crate::materials::{ConductorDesc, DielectricDesc, DiffuseDesc, NullDesc, PlasticDesc};
 use crate::math::Rgb;
@@ -53,6 +54,8 @@ impl<'a> Reader<'a> {
             // Passes light through unchanged: the boundary of a medium (see the volpath integrator).
             "null" => MaterialModel::Null(NullDesc {}),
             "principled" => self.principled(&p)?,
+            // Two-sided by itself: both faces are the same sheet.
+            "principledthin" => return Ok((self.principled_thin(&p)?, true)),
             "blendbsdf" => self.blend(&p)?,
             "pplastic" => self.pplastic(&p)?,
             "hair" => self.hair(&p)?,
@@ -203,6 +206,41 @@ impl<'a> Reader<'a> {
             specular_sampling_rate: p.float("main_specular_sampling_rate", 1.0)?,
             clearcoat_sampling_rate: p.float("clearcoat_sampling_rate", 1.0)?,
         }))
+    }
+
+    /// `principledthin`: every parameter but the sampling rates a texture or a value (`eta`
+    /// too, unbounded), with Mitsuba's defaults.
+    fn principled_thin(&mut self, p: &Props<'a>) -> Result<MaterialModel, Error> {
+        let d = PrincipledThinDesc::default();
+        let tex = |name: &str, default: &TextureDesc| -> Result<TextureDesc, Error> {
+            let fallback = match default {
+                TextureDesc::Constant { color } => *color,
+                _ => Rgb::BLACK,
+            };
+            if name == "base_color" {
+                self.texture(p, name, fallback)
+            } else {
+                self.float_texture(p, name, fallback.r)
+            }
+        };
+        let model = MaterialModel::PrincipledThin(PrincipledThinDesc {
+            base_color: tex("base_color", &d.base_color)?,
+            roughness: tex("roughness", &d.roughness)?,
+            anisotropic: tex("anisotropic", &d.anisotropic)?,
+            spec_trans: tex("spec_trans", &d.spec_trans)?,
+            eta: tex("eta", &d.eta)?,
+            spec_tint: tex("spec_tint", &d.spec_tint)?,
+            sheen: tex("sheen", &d.sheen)?,
+            sheen_tint: tex("sheen_tint", &d.sheen_tint)?,
+            flatness: tex("flatness", &d.flatness)?,
+            diff_trans: tex("diff_trans", &d.diff_trans)?,
+            diffuse_reflectance_sampling_rate: p.float("diffuse_reflectance_sampling_rate", 1.0)?,
+            diffuse_transmittance_sampling_rate: p.float("diffuse_transmittance_sampling_rate", 1.0)?,
+            specular_reflectance_sampling_rate: p.float("specular_reflectance_sampling_rate", 1.0)?,
+            specular_transmittance_sampling_rate: p.float("specular_transmittance_sampling_rate", 1.0)?,
+        });
+        self.warn_unused(p);
+        Ok(model)
     }
 
     /// `blendbsdf`: exactly two nested BSDFs (nested or `<ref>`), in the order the file
