@@ -316,3 +316,82 @@ fn mask(k: &mut Keys) -> Result<Read, Error> {
 fn null(_k: &mut Keys) -> Result<Read, Error> {
     Ok((NullDesc {}.into(), false))
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::materials::{MaterialModel, SceneDesc};
+    use std::path::Path;
+
+    /// A scene of one material object (given as JSON text) named `m`.
+    fn read(material: &str) -> Result<SceneDesc, String> {
+        let text = format!(
+            "{{\n\"camera\": {{\"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"fov\": 40}},\n\
+             \"film\": {{\"width\": 4, \"height\": 4}},\n\
+             \"materials\": {{\n\"m\": {material}\n}}\n}}"
+        );
+        super::super::read(Path::new("s.json"), &text).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn every_type_reads_its_smallest_object() {
+        let smallest = [
+            r#"{"type": "diffuse", "reflectance": 0.5}"#,
+            r#"{"type": "phong", "kd": 0.5}"#,
+            r#"{"type": "mirror"}"#,
+            r#"{"type": "conductor", "metal": "Au", "alpha": 0.2}"#,
+            r#"{"type": "dielectric"}"#,
+            r#"{"type": "plastic", "diffuse": [0.1, 0.2, 0.3]}"#,
+            r#"{"type": "pplastic", "diffuse": 0.5}"#,
+            r#"{"type": "polarizer"}"#,
+            r#"{"type": "coateddiffuse"}"#,
+            r#"{"type": "principled"}"#,
+            r#"{"type": "blend", "weight": 0.5, "materials": [{"type": "null"}, {"type": "mirror"}]}"#,
+            r#"{"type": "normalmap", "normals": 0.5, "material": {"type": "diffuse", "reflectance": 1}}"#,
+            r#"{"type": "bumpmap", "height": 0.5, "material": {"type": "diffuse", "reflectance": 1}}"#,
+            r#"{"type": "mask", "opacity": 0.5, "material": {"type": "diffuse", "reflectance": 1}}"#,
+            r#"{"type": "null"}"#,
+        ];
+        assert_eq!(smallest.len(), super::READERS.len(), "a case per material type");
+        for m in smallest {
+            let d = read(m).unwrap_or_else(|e| panic!("{m}: {e}"));
+            assert_eq!(d.materials.len(), 1, "{m}");
+        }
+    }
+
+    #[test]
+    fn keys_land_in_the_description() {
+        let d = read(r#"{"type": "dielectric", "ior": 1.33, "alpha": 0.1}"#).unwrap();
+        let MaterialModel::Dielectric(g) = &d.materials[0].model else { panic!("{:?}", d.materials[0].model) };
+        assert_eq!(g.eta, 1.33);
+        assert!(g.roughness.is_some() && !g.thin);
+        let d = read(r#"{"type": "dielectric", "thin": true, "alpha": 0.1, "distribution": "none"}"#).unwrap();
+        let MaterialModel::Dielectric(g) = &d.materials[0].model else { panic!() };
+        assert!(g.thin && g.roughness.is_none(), "a thin sheet is smooth; its roughness keys are not read");
+        assert!(!d.materials[0].two_sided);
+    }
+
+    #[test]
+    fn an_unknown_key_is_refused_where_it_is() {
+        let e = read("{\"type\": \"diffuse\",\n \"reflectance\": 0.5,\n \"reflectanse\": 0.5}").unwrap_err();
+        // The key is on the object's third line, the file's seventh.
+        assert!(e.contains("s.json:7:") && e.contains("'reflectanse'") && e.contains("reflectance"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+
+    #[test]
+    fn an_unknown_type_or_a_bad_value_is_one_line_naming_the_material() {
+        let nested = r#"{"type": "normalmap", "normals": 0.5, "material": {"type": "mask", "opacity": 1,
+            "material": {"type": "bumpmap", "height": 0.5, "material": {"type": "null"}}}}"#;
+        for (m, needles) in [
+            (r#"{"type": "difuse", "reflectance": 0.5}"#, ["'difuse'", "coateddiffuse"]),
+            (r#"{"type": "phong", "kd": 0.5, "exponent": "high"}"#, ["material 'm'", "'exponent'"]),
+            (r#"{"type": "diffuse"}"#, ["material 'm'", "needs 'reflectance'"]),
+            (r#"{"reflectance": 0.5}"#, ["material 'm'", "needs a \"type\""]),
+            (nested, ["material 'm'", "inside another one"]),
+        ] {
+            let e = read(m).unwrap_err();
+            assert!(e.starts_with("s.json:") && needles.iter().all(|n| e.contains(n)), "{m}: {e}");
+            assert_eq!(e.lines().count(), 1, "{e}");
+        }
+    }
+}
