@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::materials::{
     conductor_preset, principled_eta_of_specular, BlendDesc, BlendPartDesc, BumpMapDesc, CoatedDiffuseDesc,
     ConductorDesc, DielectricDesc, DiffuseDesc, MaskDesc, MaterialDesc, MaterialModel, NormalMapDesc, NullDesc,
-    PPlasticDesc, PhongDesc, PlasticDesc, PrincipledDesc,
+    PPlasticDesc, PhongDesc, PlasticDesc, PrincipledDesc, PrincipledThinDesc,
 };
 use crate::math::Rgb;
 use serde::de::DeserializeOwned;
@@ -33,6 +33,7 @@ const READERS: &[(&str, Reader)] = &[
     ("polarizer", polarizer),
     ("coateddiffuse", coated_diffuse),
     ("principled", principled),
+    ("principledthin", principled_thin),
     ("blend", blend),
     ("normalmap", normal_map),
     ("bumpmap", bump_map),
@@ -267,6 +268,39 @@ fn principled(k: &mut Keys) -> Result<Read, Error> {
     Ok((desc.into(), k.get("two_sided")?.unwrap_or(true)))
 }
 
+/// Mitsuba's thin principled BSDF, two-sided by itself; every key optional, with Mitsuba's
+/// names and defaults.
+fn principled_thin(k: &mut Keys) -> Result<Read, Error> {
+    let d = PrincipledThinDesc::default();
+    let mut tex = |key: &'static str, default: &TextureDesc| -> Result<TextureDesc, Error> {
+        Ok(k.texture(key)?.unwrap_or_else(|| default.clone()))
+    };
+    let mut desc = PrincipledThinDesc {
+        base_color: tex("base_color", &d.base_color)?,
+        roughness: tex("roughness", &d.roughness)?,
+        anisotropic: tex("anisotropic", &d.anisotropic)?,
+        spec_trans: tex("spec_trans", &d.spec_trans)?,
+        eta: tex("eta", &d.eta)?,
+        spec_tint: tex("spec_tint", &d.spec_tint)?,
+        sheen: tex("sheen", &d.sheen)?,
+        sheen_tint: tex("sheen_tint", &d.sheen_tint)?,
+        flatness: tex("flatness", &d.flatness)?,
+        diff_trans: tex("diff_trans", &d.diff_trans)?,
+        ..d
+    };
+    for (key, rate) in [
+        ("diffuse_reflectance_sampling_rate", &mut desc.diffuse_reflectance_sampling_rate),
+        ("diffuse_transmittance_sampling_rate", &mut desc.diffuse_transmittance_sampling_rate),
+        ("specular_reflectance_sampling_rate", &mut desc.specular_reflectance_sampling_rate),
+        ("specular_transmittance_sampling_rate", &mut desc.specular_transmittance_sampling_rate),
+    ] {
+        if let Some(v) = k.get(key)? {
+            *rate = v;
+        }
+    }
+    Ok((desc.into(), true))
+}
+
 /// (1 - weight) · first + weight · second, the two in `materials`.
 fn blend(k: &mut Keys) -> Result<Read, Error> {
     let weight = k.required_texture("weight")?;
@@ -345,6 +379,7 @@ mod tests {
             r#"{"type": "polarizer"}"#,
             r#"{"type": "coateddiffuse"}"#,
             r#"{"type": "principled"}"#,
+            r#"{"type": "principledthin", "diff_trans": 1.5, "specular_reflectance_sampling_rate": 2}"#,
             r#"{"type": "blend", "weight": 0.5, "materials": [{"type": "null"}, {"type": "mirror"}]}"#,
             r#"{"type": "normalmap", "normals": 0.5, "material": {"type": "diffuse", "reflectance": 1}}"#,
             r#"{"type": "bumpmap", "height": 0.5, "material": {"type": "diffuse", "reflectance": 1}}"#,
