@@ -32,7 +32,7 @@ use crate::materials::{Bsdf, ShadedBsdf};
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};
 use crate::media::{sample_distance, Medium};
 use crate::sampling::{power_heuristic, Sampler};
-use crate::world::{SurfaceInteraction, World};
+use crate::world::{Hit, SurfaceInteraction, World};
 
 /// The most passages (null boundaries, hidden emitters) one path or shadow ray makes; a
 /// ray that meets more (a stack of coincident boundaries) ends there.
@@ -43,142 +43,208 @@ pub fn li(s: &VolpathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sample
     if max_depth == 0 {
         return Rgb::BLACK;
     }
-    // Shadow rays must look for passages only where there are any.
-    let passable = scene.has_masks || scene.has_passage_materials || !scene.media.is_empty();
-    let mut l = Rgb::BLACK;
-    let mut throughput = Rgb::WHITE;
-    // Undoes the 1/eta^2 radiance scaling for Russian roulette, as in `path`.
-    let mut eta_scale = 1.0f32;
-    let mut ray = *camera_ray;
-    let mut medium = scene.camera_medium;
-    // The last scattering event: its direction density, whether it was delta (or could not
-    // have been sampled by lights), and where it was.
-    let mut prev = PrevEvent { pdf: 1.0, delta: true, p: ray.origin };
-    let mut depth = 0u32; // scattering events so far
-    let mut passages = 0u32;
-    // The hero channel, and each channel's path density over their mean (`throughput` is the
-    // path contribution over that mean).
-    let channel = if scene.media.is_empty() { 0 } else { ((rng.next_f32() * 3.0) as usize).min(2) };
-    let mut density_ratio = Rgb::WHITE;
-
+    let mut path = VolPath::new(s, scene, max_depth, camera_ray, rng);
     loop {
         c.rays += 1;
-        let hit = scene.intersect(&ray);
-
-        if let Some(mi) = medium {
-            let m = &scene.media[mi as usize];
-            let t_max = hit.map_or(f32::INFINITY, |h| h.t);
-            let flight = sample_distance(m, &ray, t_max, channel, rng);
-            let mean = (density_ratio * flight.density).average();
-            if !(mean > 0.0) {
-                break;
-            }
-            throughput = throughput * flight.value / mean;
-            density_ratio = density_ratio * flight.density / mean;
-            if throughput.is_black() {
-                break;
-            }
-            if let Some(t) = flight.t {
-                depth += 1;
-                if depth >= max_depth {
-                    break;
-                }
-                let p = ray.at(t);
-                let wo = -ray.dir;
-                if m.sample_emitters {
-                    l += throughput * light_at_medium_point(scene, m, p, wo, medium, passable, rng, c);
-                }
-                let ps = m.phase.sample(wo, rng.next_2d());
-                prev.pdf = ps.pdf;
-                // Without light sampling here, lights the phase sample reaches count fully.
-                prev.delta = !m.sample_emitters;
-                prev.p = p;
-                ray = Ray::new(p, ps.wi);
-                if !roulette(s, depth, &mut throughput, eta_scale, rng) {
-                    break;
-                }
-                continue;
+        let hit = scene.intersect(&path.ray);
+        if let Some(mi) = path.medium {
+            match path.through_medium(mi, hit.map_or(f32::INFINITY, |h| h.t), rng, c) {
+                Flight::Scattered => continue,
+                Flight::Ended => break,
+                Flight::ReachedSurface => {}
             }
         }
-
         let Some(hit) = hit else {
-            if !(depth == 0 && s.hide_emitters) {
-                add_environment(scene, &ray, Strategy::Mis, &prev, throughput, &mut l);
-            }
+            path.escape();
             break;
         };
-        let si = scene.interaction(&ray, &hit);
+        if !path.at_surface(&hit, rng, c) {
+            break;
+        }
+    }
+    path.l
+}
+
+/// What a ray's flight through a medium came to.
+enum Flight {
+    /// It scattered in the medium (the path goes on from there).
+    Scattered,
+    /// It reached the surface it was traced to (or left the scene).
+    ReachedSurface,
+    /// The path ends.
+    Ended,
+}
+
+/// One volumetric path between its events: what `li` advances.
+struct VolPath<'a> {
+    s: &'a VolpathSettings,
+    scene: &'a World,
+    max_depth: u32,
+    /// Whether shadow rays must look for passages (only where there are any).
+    passable: bool,
+    /// The radiance gathered so far.
+    l: Rgb,
+    throughput: Rgb,
+    /// Undoes the 1/eta^2 radiance scaling for Russian roulette, as in `path`.
+    eta_scale: f32,
+    ray: Ray,
+    medium: Option<u32>,
+    /// The last scattering event: its direction density, whether it was delta (or could not
+    /// have been sampled by lights), and where it was.
+    prev: PrevEvent,
+    /// Scattering events so far.
+    depth: u32,
+    passages: u32,
+    /// The hero channel, and each channel's path density over their mean (`throughput` is
+    /// the path contribution over that mean).
+    channel: usize,
+    density_ratio: Rgb,
+}
+
+impl<'a> VolPath<'a> {
+    fn new(s: &'a VolpathSettings, scene: &'a World, max_depth: u32, camera_ray: &Ray, rng: &mut Sampler) -> Self {
+        let channel = if scene.media.is_empty() { 0 } else { ((rng.next_f32() * 3.0) as usize).min(2) };
+        VolPath {
+            s,
+            scene,
+            max_depth,
+            passable: scene.has_masks || scene.has_passage_materials || !scene.media.is_empty(),
+            l: Rgb::BLACK,
+            throughput: Rgb::WHITE,
+            eta_scale: 1.0,
+            ray: *camera_ray,
+            medium: scene.camera_medium,
+            prev: PrevEvent { pdf: 1.0, delta: true, p: camera_ray.origin },
+            depth: 0,
+            passages: 0,
+            channel,
+            density_ratio: Rgb::WHITE,
+        }
+    }
+
+    /// Counts a passage; false when the path has made too many.
+    fn pass(&mut self) -> bool {
+        self.passages += 1;
+        self.passages <= MAX_PASSAGES
+    }
+
+    /// The flight through medium `mi` up to `t_max`: a free flight drawn on the hero
+    /// channel, and where it scatters, light sampling and a phase-function sample.
+    fn through_medium(&mut self, mi: u32, t_max: f32, rng: &mut Sampler, c: &mut Counters) -> Flight {
+        let m = &self.scene.media[mi as usize];
+        let flight = sample_distance(m, &self.ray, t_max, self.channel, rng);
+        let mean = (self.density_ratio * flight.density).average();
+        if !(mean > 0.0) {
+            return Flight::Ended;
+        }
+        self.throughput = self.throughput * flight.value / mean;
+        self.density_ratio = self.density_ratio * flight.density / mean;
+        if self.throughput.is_black() {
+            return Flight::Ended;
+        }
+        let Some(t) = flight.t else { return Flight::ReachedSurface };
+        self.depth += 1;
+        if self.depth >= self.max_depth {
+            return Flight::Ended;
+        }
+        let p = self.ray.at(t);
+        let wo = -self.ray.dir;
+        if m.sample_emitters {
+            let light = light_at_medium_point(self.scene, m, p, wo, self.medium, self.passable, rng, c);
+            self.l += self.throughput * light;
+        }
+        let ps = m.phase.sample(wo, rng.next_2d());
+        self.prev.pdf = ps.pdf;
+        // Without light sampling here, lights the phase sample reaches count fully.
+        self.prev.delta = !m.sample_emitters;
+        self.prev.p = p;
+        self.ray = Ray::new(p, ps.wi);
+        if !roulette(self.s, self.depth, &mut self.throughput, self.eta_scale, rng) {
+            return Flight::Ended;
+        }
+        Flight::Scattered
+    }
+
+    /// The ray left the scene: what the environment sends back along it.
+    fn escape(&mut self) {
+        if !(self.depth == 0 && self.s.hide_emitters) {
+            add_environment(self.scene, &self.ray, Strategy::Mis, &self.prev, self.throughput, &mut self.l);
+        }
+    }
+
+    /// The path at a surface: emission, passages (hidden emitters, masks, null and thin
+    /// boundaries), light sampling and a BSDF sample; false when the path ends.
+    fn at_surface(&mut self, hit: &Hit, rng: &mut Sampler, c: &mut Counters) -> bool {
+        let scene = self.scene;
+        let si = scene.interaction(&self.ray, hit);
         let boundary = scene.instances[si.instance as usize].media;
 
         if let Some(li_idx) = si.light {
-            if depth == 0 && s.hide_emitters {
+            if self.depth == 0 && self.s.hide_emitters {
                 // Looked through, as `path` looks through hidden emitters.
-                passages += 1;
-                if passages > MAX_PASSAGES {
-                    break;
+                if !self.pass() {
+                    return false;
                 }
-                ray = spawn_ray(&si, ray.dir);
-                continue;
+                self.ray = spawn_ray(&si, self.ray.dir);
+                return true;
             }
-            add_emitted(scene, &si, &ray, li_idx, Strategy::Mis, &prev, throughput, &mut l);
+            add_emitted(scene, &si, &self.ray, li_idx, Strategy::Mis, &self.prev, self.throughput, &mut self.l);
         }
 
         // A masked surface lets the path through unscattered with probability 1 - opacity:
         // a passage, as in `path` (depth and the MIS state stay those of the last event).
         if scene.has_masks {
-            let o = opacity(scene, &si, ray.dir);
+            let o = opacity(scene, &si, self.ray.dir);
             if o < 1.0 && rng.next_f32() >= o {
-                passages += 1;
-                if passages > MAX_PASSAGES {
-                    break;
+                if !self.pass() {
+                    return false;
                 }
-                medium = boundary.medium_after(ray.dir.dot(si.ng), medium);
-                ray = spawn_ray(&si, ray.dir);
-                continue;
+                self.medium = boundary.medium_after(self.ray.dir.dot(si.ng), self.medium);
+                self.ray = spawn_ray(&si, self.ray.dir);
+                return true;
             }
         }
+        self.scatter_at_surface(&si, rng, c)
+    }
 
-        let wo_world = -ray.dir;
-        let (bsdf, frame) = shading(scene, &si, wo_world);
+    /// Light sampling and a BSDF sample at a surface; false when the path ends.
+    fn scatter_at_surface(&mut self, si: &SurfaceInteraction, rng: &mut Sampler, c: &mut Counters) -> bool {
+        let scene = self.scene;
+        let boundary = scene.instances[si.instance as usize].media;
+        let wo_world = -self.ray.dir;
+        let (bsdf, frame) = shading(scene, si, wo_world);
         let wo = frame.to_local(wo_world);
 
         // Next-event estimation, when one more segment is allowed.
-        if !bsdf.is_delta() && depth + 1 < max_depth {
-            let at = SurfacePoint { si: &si, bsdf: &bsdf, frame: &frame, wo, medium, passable };
-            add_light_at_surface(scene, &at, throughput, &mut l, rng, c);
+        if !bsdf.is_delta() && self.depth + 1 < self.max_depth {
+            let at = SurfacePoint { si, bsdf: &bsdf, frame: &frame, wo, medium: self.medium, passable: self.passable };
+            add_light_at_surface(scene, &at, self.throughput, &mut self.l, rng, c);
         }
 
         let u_lobe = rng.next_f32();
         let u = rng.next_2d();
         let Some(bs) = bsdf.sample(wo, u_lobe, u) else {
-            break;
+            return false;
         };
         if bs.weight.is_black() {
-            break;
+            return false;
         }
         let passage = is_passage(&bsdf.bsdf, wo, &bs);
-        if !passage && depth + 1 >= max_depth {
-            break;
+        if !passage && self.depth + 1 >= self.max_depth {
+            return false;
         }
-        throughput *= bs.weight;
+        self.throughput *= bs.weight;
         let wi_world = frame.to_world(bs.wi);
-        medium = boundary.medium_after(wi_world.dot(si.ng), medium);
-        ray = spawn_ray(&si, wi_world);
+        self.medium = boundary.medium_after(wi_world.dot(si.ng), self.medium);
+        self.ray = spawn_ray(si, wi_world);
         if passage {
-            passages += 1;
-            if passages > MAX_PASSAGES {
-                break;
-            }
-            continue;
+            return self.pass();
         }
-        depth += 1;
-        eta_scale *= bs.eta * bs.eta;
-        prev = PrevEvent { pdf: bs.pdf, delta: bs.delta, p: si.p };
-        if !roulette(s, depth, &mut throughput, eta_scale, rng) {
-            break;
-        }
+        self.depth += 1;
+        self.eta_scale *= bs.eta * bs.eta;
+        self.prev = PrevEvent { pdf: bs.pdf, delta: bs.delta, p: si.p };
+        roulette(self.s, self.depth, &mut self.throughput, self.eta_scale, rng)
     }
-    l
 }
 
 /// A surface scattering point as next-event estimation sees it.
