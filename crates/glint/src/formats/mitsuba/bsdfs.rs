@@ -157,20 +157,24 @@ impl<'a> Reader<'a> {
         })
     }
 
+    /// A parameter of `principled` or `principledthin`: `base_color` a colour texture, the
+    /// others float textures, each defaulting to the constant `default` gives.
+    fn principled_texture(&self, p: &Props<'a>, name: &str, default: &TextureDesc) -> Result<TextureDesc, Error> {
+        let fallback = match default {
+            TextureDesc::Constant { color } => *color,
+            _ => Rgb::BLACK,
+        };
+        if name == "base_color" {
+            self.texture(p, name, fallback)
+        } else {
+            self.float_texture(p, name, fallback.r)
+        }
+    }
+
     fn principled(&mut self, p: &Props<'a>) -> Result<MaterialModel, Error> {
         let el = p.el;
         let d = PrincipledDesc::default();
-        let tex = |name: &str, default: &TextureDesc| -> Result<TextureDesc, Error> {
-            let fallback = match default {
-                TextureDesc::Constant { color } => *color,
-                _ => Rgb::BLACK,
-            };
-            if name == "base_color" {
-                self.texture(p, name, fallback)
-            } else {
-                self.float_texture(p, name, fallback.r)
-            }
-        };
+        let tex = |name: &str, default: &TextureDesc| self.principled_texture(p, name, default);
         let spec_trans = tex("spec_trans", &d.spec_trans)?;
         // Mitsuba treats a lobe as present when its parameter is given and not the float 0.
         let has_spec_trans = !matches!(&spec_trans, TextureDesc::Constant { color } if color.is_black());
@@ -212,17 +216,7 @@ impl<'a> Reader<'a> {
     /// too, unbounded), with Mitsuba's defaults.
     fn principled_thin(&mut self, p: &Props<'a>) -> Result<MaterialModel, Error> {
         let d = PrincipledThinDesc::default();
-        let tex = |name: &str, default: &TextureDesc| -> Result<TextureDesc, Error> {
-            let fallback = match default {
-                TextureDesc::Constant { color } => *color,
-                _ => Rgb::BLACK,
-            };
-            if name == "base_color" {
-                self.texture(p, name, fallback)
-            } else {
-                self.float_texture(p, name, fallback.r)
-            }
-        };
+        let tex = |name: &str, default: &TextureDesc| self.principled_texture(p, name, default);
         let model = MaterialModel::PrincipledThin(PrincipledThinDesc {
             base_color: tex("base_color", &d.base_color)?,
             roughness: tex("roughness", &d.roughness)?,
