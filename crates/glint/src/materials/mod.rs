@@ -11,11 +11,14 @@
 //! - its BSDF with an `impl Scatter` (see `bsdf`): eval, pdf, sample.
 //!
 //! None of the three traits has a default method, so the compiler names any the new type
-//! lacks. One line in the `materials!` list below then makes the [`MaterialModel`],
-//! [`MaterialKind`] and [`Bsdf`] variants, their static dispatch and their `From`
-//! conversions; each scene format reads it with one function of its reader.
+//! lacks. Its `mod` line and one entry in the `materials!` list below then make the
+//! [`MaterialModel`], [`MaterialKind`] and [`Bsdf`] variants, their static dispatch, their
+//! `From` conversions and the module's re-export; each scene format reads it with one
+//! function of its reader.
 //! docs/rendering.md ("Adding a material") walks through it.
 
+// The material modules (each named in the `materials!` list below, which re-exports it) and
+// what they share.
 mod blend;
 mod coated_diffuse;
 mod conductor;
@@ -35,36 +38,9 @@ mod roughness;
 mod surface;
 mod texture;
 mod texture_cache;
-pub use blend::{BlendBsdf, BlendDesc, BlendMaterial, BlendMaterialPart, BlendPart, BlendPartDesc};
-pub use coated_diffuse::{CoatedDiffuse, CoatedDiffuseDesc, CoatedDiffuseMaterial};
-pub use conductor::{Conductor, ConductorDesc, ConductorMaterial, RoughConductor};
-pub use dielectric::{
-    Dielectric, DielectricDesc, DielectricMaterial, DielectricSurface, RoughDielectric, ThinDielectric,
-};
-pub use diffuse::{Diffuse, DiffuseDesc, DiffuseMaterial};
-pub use gltf::{
-    sheen_albedo, sheen_albedo_quadrature, GltfAlpha, GltfAlphaMode, GltfExtensionTextures, GltfMaterial,
-    GltfMaterialDesc, GltfPbr, GltfTexture, ALPHA_ATTRIBUTE, COLOR_ATTRIBUTE, SHEEN_ALBEDO_TOLERANCE,
-    SHEEN_MIN_ROUGHNESS, TANGENT_ATTRIBUTE, TANGENT_SIGN_ATTRIBUTE, UV1_ATTRIBUTE,
-};
-pub use hair::{HairBsdf, HairDesc, EUMELANIN_SIGMA_A, PHEOMELANIN_SIGMA_A};
-pub use passthrough::{Black, BlackDesc, Null, NullDesc};
 pub use perturbed::{bump_shadowing, flip_invalid, normal_map_frame, ShadedBsdf};
-pub use phong::{Phong, PhongDesc, PhongMaterial};
-pub use plastic::{PlasticDesc, PlasticMaterial, PlasticParams};
-pub use pplastic::{PPlasticDesc, PPlasticMaterial, PPlasticParams};
-pub use principled::{
-    principled_alphas, principled_eta_of_specular, AnisoGgx, Principled, PrincipledDesc, PrincipledInputs,
-    PrincipledMaterial, PrincipledRates,
-};
-pub use principled_thin::{
-    PrincipledThin, PrincipledThinDesc, PrincipledThinInputs, PrincipledThinMaterial, PrincipledThinRates,
-};
 pub use roughness::RoughnessMap;
 pub(crate) use roughness::{constant_microfacet, roughness_map};
-pub use surface::{
-    BumpMapDesc, BumpMapMaterial, MaskDesc, MaskMaterial, NormalMapDesc, NormalMapMaterial, Perturbation,
-};
 pub use texture::{Bitmap, ScalarTexture, Texture, TexturePoint};
 pub use texture_cache::TextureCache;
 
@@ -118,8 +94,9 @@ pub trait Shade {
     fn nested(&self) -> Option<&MaterialKind>;
 }
 
-/// Makes the three closed sets of materials from one list of
-/// `Variant(Description => Built) [BsdfVariant(BsdfType), ...]`, a line per material:
+/// Makes the three closed sets of materials from one list, grouped by module
+/// (`mod module { Variant(Description => Built) [BsdfVariant(BsdfType), ...], }`, a line
+/// per material), and re-exports each module:
 /// - [`MaterialModel`], the descriptions (serde, tagged by `type`: the variant's name in
 ///   lower case), with the [`Describe`] dispatch;
 /// - [`MaterialKind`], the built materials, with the [`Shade`] dispatch;
@@ -127,20 +104,22 @@ pub trait Shade {
 ///
 /// each dispatch one arm per variant, no wildcard, and the `From` conversions into each enum.
 macro_rules! materials {
-    ($($(#[doc = $doc:literal])* $variant:ident($desc:ty => $kind:ty) [$($bvariant:ident($bty:ty)),*],)+) => {
+    ($(mod $module:ident { $($(#[doc = $doc:literal])* $variant:ident($desc:ty => $kind:ty) [$($bvariant:ident($bty:ty)),*],)+ })+) => {
+        $(pub use $module::*;)+
+
         /// A material as a scene describes it.
         #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
         #[serde(tag = "type", rename_all = "lowercase")]
         // Kept unboxed: a description is built once and read once.
         #[allow(clippy::large_enum_variant)]
         pub enum MaterialModel {
-            $($(#[doc = $doc])* $variant($desc),)+
+            $($($(#[doc = $doc])* $variant($desc),)+)+
         }
 
         impl MaterialModel {
             /// The built material (see [`Describe::build`]).
             pub fn build(&self, textures: &mut TextureCache) -> Result<MaterialKind, Error> {
-                match self { $(MaterialModel::$variant(d) => Ok(Describe::build(d, textures)?.into()),)+ }
+                match self { $($(MaterialModel::$variant(d) => Ok(Describe::build(d, textures)?.into()),)+)+ }
             }
 
             /// Checks every texture as a colour, then the parameters (see
@@ -149,37 +128,37 @@ macro_rules! materials {
                 for t in self.textures() {
                     checks::texture(t, "colour")?;
                 }
-                match self { $(MaterialModel::$variant(d) => Describe::validate(d),)+ }
+                match self { $($(MaterialModel::$variant(d) => Describe::validate(d),)+)+ }
             }
 
             /// See [`Describe::textures`].
             pub fn textures(&self) -> Vec<&TextureDesc> {
-                match self { $(MaterialModel::$variant(d) => Describe::textures(d),)+ }
+                match self { $($(MaterialModel::$variant(d) => Describe::textures(d),)+)+ }
             }
 
             /// See [`Describe::textures_mut`].
             pub fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
-                match self { $(MaterialModel::$variant(d) => Describe::textures_mut(d),)+ }
+                match self { $($(MaterialModel::$variant(d) => Describe::textures_mut(d),)+)+ }
             }
 
             /// See [`Describe::slots`].
             pub fn slots(&mut self) -> Vec<(&'static str, Slot<'_>)> {
-                match self { $(MaterialModel::$variant(d) => Describe::slots(d),)+ }
+                match self { $($(MaterialModel::$variant(d) => Describe::slots(d),)+)+ }
             }
         }
 
-        $(impl From<$desc> for MaterialModel {
+        $($(impl From<$desc> for MaterialModel {
             fn from(d: $desc) -> MaterialModel {
                 MaterialModel::$variant(d)
             }
-        })+
+        })+)+
 
         /// A material built: textures made, constants folded.
         // Unboxed on purpose: materials are read at every hit, and a box is a pointer chase.
         #[allow(clippy::large_enum_variant)]
         #[derive(Clone, Debug)]
         pub enum MaterialKind {
-            $($(#[doc = $doc])* $variant($kind),)+
+            $($($(#[doc = $doc])* $variant($kind),)+)+
         }
 
         // Inherent, so that callers need not import `Shade`.
@@ -187,121 +166,149 @@ macro_rules! materials {
             /// This kind's own BSDF at a hit point (see [`Shade::bsdf_at`]).
             #[inline]
             pub fn bsdf_at(&self, p: &TexturePoint) -> Bsdf {
-                match self { $(MaterialKind::$variant(m) => Shade::bsdf_at(m, p),)+ }
+                match self { $($(MaterialKind::$variant(m) => Shade::bsdf_at(m, p),)+)+ }
             }
 
             /// See [`Material::albedo`].
             pub fn albedo(&self, uv: [f32; 2]) -> Rgb {
-                match self { $(MaterialKind::$variant(m) => Shade::albedo(m, uv),)+ }
+                match self { $($(MaterialKind::$variant(m) => Shade::albedo(m, uv),)+)+ }
             }
 
             /// See [`Material::is_transmissive`].
             pub fn is_transmissive(&self) -> bool {
-                match self { $(MaterialKind::$variant(m) => Shade::is_transmissive(m),)+ }
+                match self { $($(MaterialKind::$variant(m) => Shade::is_transmissive(m),)+)+ }
             }
 
             /// The material a normal map, bump map or mask wraps; `None` for a material
             /// that scatters.
             pub fn nested(&self) -> Option<&MaterialKind> {
-                match self { $(MaterialKind::$variant(m) => Shade::nested(m),)+ }
+                match self { $($(MaterialKind::$variant(m) => Shade::nested(m),)+)+ }
             }
         }
 
-        $(impl From<$kind> for MaterialKind {
+        $($(impl From<$kind> for MaterialKind {
             fn from(m: $kind) -> MaterialKind {
                 MaterialKind::$variant(m)
             }
-        })+
+        })+)+
 
         /// A material's BSDF at one point: textures looked up. Not `Copy`: a blend owns its
         /// two parts (see `blend.rs`); every other variant is plain data.
         #[derive(Clone, Debug)]
         pub enum Bsdf {
-            $($($bvariant($bty),)*)+
+            $($($($bvariant($bty),)*)+)+
         }
 
         // Inherent, so that callers of a `Bsdf` need not import `Scatter`.
         impl Bsdf {
             /// See [`Scatter::is_delta`].
             pub fn is_delta(&self) -> bool {
-                match self { $($(Bsdf::$bvariant(b) => b.is_delta(),)*)+ }
+                match self { $($($(Bsdf::$bvariant(b) => b.is_delta(),)*)+)+ }
             }
 
             /// See [`Scatter::has_delta_lobe`].
             pub fn has_delta_lobe(&self) -> bool {
-                match self { $($(Bsdf::$bvariant(b) => b.has_delta_lobe(),)*)+ }
+                match self { $($($(Bsdf::$bvariant(b) => b.has_delta_lobe(),)*)+)+ }
             }
 
             /// See [`Scatter::eval`].
             pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-                match self { $($(Bsdf::$bvariant(b) => b.eval(wo, wi),)*)+ }
+                match self { $($($(Bsdf::$bvariant(b) => b.eval(wo, wi),)*)+)+ }
             }
 
             /// See [`Scatter::pdf`].
             pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-                match self { $($(Bsdf::$bvariant(b) => b.pdf(wo, wi),)*)+ }
+                match self { $($($(Bsdf::$bvariant(b) => b.pdf(wo, wi),)*)+)+ }
             }
 
             /// See [`Scatter::sample`].
             pub fn sample(&self, wo: Vec3, u_lobe: f32, u: [f32; 2]) -> Option<BsdfSample> {
-                match self { $($(Bsdf::$bvariant(b) => b.sample(wo, u_lobe, u),)*)+ }
+                match self { $($($(Bsdf::$bvariant(b) => b.sample(wo, u_lobe, u),)*)+)+ }
             }
 
             /// See [`Scatter::diffuse_reflectance`].
             pub fn diffuse_reflectance(&self) -> Rgb {
-                match self { $($(Bsdf::$bvariant(b) => b.diffuse_reflectance(),)*)+ }
+                match self { $($($(Bsdf::$bvariant(b) => b.diffuse_reflectance(),)*)+)+ }
             }
 
             /// See [`Scatter::passage_transmission`].
             pub fn passage_transmission(&self, wo: Vec3) -> Option<Rgb> {
-                match self { $($(Bsdf::$bvariant(b) => b.passage_transmission(wo),)*)+ }
+                match self { $($($(Bsdf::$bvariant(b) => b.passage_transmission(wo),)*)+)+ }
             }
         }
 
-        $($(impl From<$bty> for Bsdf {
+        $($($(impl From<$bty> for Bsdf {
             fn from(b: $bty) -> Bsdf {
                 Bsdf::$bvariant(b)
             }
-        })*)+
+        })*)+)+
     };
 }
 
 materials! {
-    /// Lambertian reflection (`diffuse`).
-    Diffuse(DiffuseDesc => DiffuseMaterial) [Diffuse(Diffuse)],
-    /// Diffuse plus a normalised Phong lobe (the Whitted integrator's glossy term).
-    Phong(PhongDesc => PhongMaterial) [Phong(Phong)],
-    /// Metal, smooth or rough (`conductor`, `roughconductor`).
-    Conductor(ConductorDesc => ConductorMaterial) [Conductor(Conductor), RoughConductor(RoughConductor)],
-    /// Glass, smooth, rough or thin (`dielectric`, `roughdielectric`, `thindielectric`).
-    Dielectric(DielectricDesc => DielectricMaterial)
-        [Dielectric(Dielectric), RoughDielectric(RoughDielectric), ThinDielectric(ThinDielectric)],
-    /// A diffuse base under a smooth or rough coating (`plastic`, `roughplastic`).
-    Plastic(PlasticDesc => PlasticMaterial) [Plastic(PlasticParams)],
-    /// Absorbs everything (emitters without a material).
-    Black(BlackDesc => Black) [Black(Black)],
-    /// A material shaded with a tangent-space normal map (`normalmap`).
-    NormalMap(NormalMapDesc => NormalMapMaterial) [],
-    /// A material shaded with the normals of a height field (`bumpmap`).
-    BumpMap(BumpMapDesc => BumpMapMaterial) [],
-    /// A material with an opacity (`mask`).
-    Mask(MaskDesc => MaskMaterial) [],
-    /// Lets light through unchanged (`null`): a medium's boundary.
-    Null(NullDesc => Null) [Null(Null)],
-    /// Mitsuba's `principled` (Disney) BSDF.
-    Principled(PrincipledDesc => PrincipledMaterial) [Principled(Principled)],
-    /// Mitsuba's `principledthin`: the Disney BSDF of a thin translucent sheet.
-    PrincipledThin(PrincipledThinDesc => PrincipledThinMaterial) [PrincipledThin(PrincipledThin)],
-    /// Mitsuba's `blendbsdf`: a weighted mixture of two materials.
-    Blend(BlendDesc => BlendMaterial) [Blend(BlendBsdf)],
-    /// Mitsuba's `pplastic` as its unpolarized variants render it.
-    PPlastic(PPlasticDesc => PPlasticMaterial) [PPlastic(PPlasticParams)],
-    /// Mitsuba's `hair` (Chiang et al. 2016), in a curve's frame (x around, y along).
-    Hair(HairDesc => HairBsdf) [Hair(HairBsdf)],
-    /// A glTF 2.0 metallic-roughness material with the KHR extensions.
-    Gltf(GltfMaterialDesc => GltfMaterial) [GltfPbr(GltfPbr)],
-    /// pbrt-v4's `coateddiffuse`: a diffuse base under a slab and a coating, by random walks.
-    CoatedDiffuse(CoatedDiffuseDesc => CoatedDiffuseMaterial) [CoatedDiffuse(CoatedDiffuse)],
+    mod diffuse {
+        /// Lambertian reflection (`diffuse`).
+        Diffuse(DiffuseDesc => DiffuseMaterial) [Diffuse(Diffuse)],
+    }
+    mod phong {
+        /// Diffuse plus a normalised Phong lobe (the Whitted integrator's glossy term).
+        Phong(PhongDesc => PhongMaterial) [Phong(Phong)],
+    }
+    mod conductor {
+        /// Metal, smooth or rough (`conductor`, `roughconductor`).
+        Conductor(ConductorDesc => ConductorMaterial) [Conductor(Conductor), RoughConductor(RoughConductor)],
+    }
+    mod dielectric {
+        /// Glass, smooth, rough or thin (`dielectric`, `roughdielectric`, `thindielectric`).
+        Dielectric(DielectricDesc => DielectricMaterial)
+            [Dielectric(Dielectric), RoughDielectric(RoughDielectric), ThinDielectric(ThinDielectric)],
+    }
+    mod plastic {
+        /// A diffuse base under a smooth or rough coating (`plastic`, `roughplastic`).
+        Plastic(PlasticDesc => PlasticMaterial) [Plastic(PlasticParams)],
+    }
+    mod passthrough {
+        /// Absorbs everything (emitters without a material).
+        Black(BlackDesc => Black) [Black(Black)],
+        /// Lets light through unchanged (`null`): a medium's boundary.
+        Null(NullDesc => Null) [Null(Null)],
+    }
+    mod surface {
+        /// A material shaded with a tangent-space normal map (`normalmap`).
+        NormalMap(NormalMapDesc => NormalMapMaterial) [],
+        /// A material shaded with the normals of a height field (`bumpmap`).
+        BumpMap(BumpMapDesc => BumpMapMaterial) [],
+        /// A material with an opacity (`mask`).
+        Mask(MaskDesc => MaskMaterial) [],
+    }
+    mod principled {
+        /// Mitsuba's `principled` (Disney) BSDF.
+        Principled(PrincipledDesc => PrincipledMaterial) [Principled(Principled)],
+    }
+    mod principled_thin {
+        /// Mitsuba's `principledthin`: the Disney BSDF of a thin translucent sheet.
+        PrincipledThin(PrincipledThinDesc => PrincipledThinMaterial) [PrincipledThin(PrincipledThin)],
+    }
+    mod blend {
+        /// Mitsuba's `blendbsdf`: a weighted mixture of two materials.
+        Blend(BlendDesc => BlendMaterial) [Blend(BlendBsdf)],
+    }
+    mod pplastic {
+        /// Mitsuba's `pplastic` as its unpolarized variants render it.
+        PPlastic(PPlasticDesc => PPlasticMaterial) [PPlastic(PPlasticParams)],
+    }
+    mod hair {
+        /// Mitsuba's `hair` (Chiang et al. 2016), in a curve's frame (x around, y along).
+        Hair(HairDesc => HairBsdf) [Hair(HairBsdf)],
+    }
+    mod gltf {
+        /// A glTF 2.0 metallic-roughness material with the KHR extensions.
+        Gltf(GltfMaterialDesc => GltfMaterial) [GltfPbr(GltfPbr)],
+    }
+    mod coated_diffuse {
+        /// pbrt-v4's `coateddiffuse`: a diffuse base under a slab and a coating, by random walks.
+        CoatedDiffuse(CoatedDiffuseDesc => CoatedDiffuseMaterial) [CoatedDiffuse(CoatedDiffuse)],
+    }
 }
 
 impl MaterialModel {
