@@ -68,7 +68,7 @@ impl Scatter for Diffuse {
 ///
 /// | Parameter | Type | Default (JSON, Mitsuba) | |
 /// |---|---|---|---|
-/// | `reflectance` | texture | 0.5 | the albedo |
+/// | `reflectance` | texture | JSON: required; Mitsuba 0.5 | the albedo |
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DiffuseDesc {
     pub reflectance: TextureDesc,
