@@ -10,8 +10,8 @@
 //!   point, the denoiser's albedo, whether it transmits, the material it wraps;
 //! - its BSDF with an `impl Scatter` (see `bsdf`): eval, pdf, sample.
 //!
-//! None of the three traits has a default method, so the compiler names any the new type
-//! lacks. Its `mod` line and one entry in the `materials!` list below then make the
+//! None of the three traits has a default method (but `Scatter::passage_transmission`, for
+//! the surfaces volpath crosses), so the compiler names any the new type lacks. Its `mod` line and one entry in the `materials!` list below then make the
 //! [`MaterialModel`], [`MaterialKind`] and [`Bsdf`] variants, their static dispatch, their
 //! `From` conversions and the module's re-export; each scene format reads it with one
 //! function of its reader.
