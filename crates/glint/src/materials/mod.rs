@@ -11,9 +11,10 @@
 //! - its BSDF with an `impl Scatter` (see `bsdf`): eval, pdf, sample.
 //!
 //! None of the three traits has a default method (but `Scatter::passage_transmission`, for
-//! the surfaces volpath crosses), so the compiler names any the new type lacks. Its `mod` line and one entry in the `materials!` list below then make the
-//! [`MaterialModel`], [`MaterialKind`] and [`Bsdf`] variants, their static dispatch, their
-//! `From` conversions and the module's re-export; each scene format reads it with one
+//! the surfaces volpath crosses), so the compiler names any the new type lacks. Its `mod`
+//! line and one entry in the `materials!` list below then make the [`MaterialModel`],
+//! [`MaterialKind`] and [`Bsdf`] variants, their static dispatch, their `From` conversions
+//! and the module's re-export; each scene format reads it with one
 //! function of its reader.
 //! docs/rendering.md ("Adding a material") walks through it.
 
