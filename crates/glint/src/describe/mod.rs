@@ -687,7 +687,26 @@ impl Default for CameraDesc {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::materials::{DiffuseDesc, MaterialDesc, MaterialModel, SceneDesc};
+
+    /// A material set of one textured material: all these tests need of one (the
+    /// description is generic over glint's own set, which lives above `describe`).
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+    struct Textured {
+        reflectance: TextureDesc,
+    }
+
+    impl MaterialSet for Textured {
+        fn textures(&self) -> Vec<&TextureDesc> {
+            vec![&self.reflectance]
+        }
+
+        fn textures_mut(&mut self) -> Vec<&mut TextureDesc> {
+            vec![&mut self.reflectance]
+        }
+    }
+
+    type SceneDesc = super::SceneDesc<Textured>;
+    type MaterialDesc = super::MaterialDesc<Textured>;
 
     fn small_film(aovs: Vec<Aov>) -> FilmDesc {
         FilmDesc { width: 4, height: 3, filter: PixelFilter::Box, loc: SourceLoc::default(), crop: None, aovs }
@@ -724,7 +743,7 @@ mod tests {
         };
         d.materials.push(MaterialDesc {
             name: "wood".into(),
-            model: MaterialModel::Diffuse(DiffuseDesc { reflectance: bitmap("wood.png") }),
+            model: Textured { reflectance: bitmap("wood.png") },
             two_sided: false,
             loc: SourceLoc::default(),
         });
