@@ -25,6 +25,7 @@ pub mod describe;
 pub mod error;
 pub mod formats;
 pub mod geometry;
+pub mod gradient;
 pub mod integrators;
 pub mod io;
 pub mod lights;

@@ -306,7 +306,7 @@ fn add_shape(
 }
 
 /// A described material, built: its kind with textures loaded, its sides.
-fn material(m: &MaterialDesc, textures: &mut TextureCache) -> Result<Material, Error> {
+pub(crate) fn material(m: &MaterialDesc, textures: &mut TextureCache) -> Result<Material, Error> {
     let kind = m.model.build(textures).map_err(|e| e.or_at(&m.loc))?;
     let mut out = Material::new(m.name.clone(), kind, m.two_sided);
     if let MaterialModel::Gltf(g) = &m.model {

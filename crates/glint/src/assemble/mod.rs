@@ -10,8 +10,8 @@ mod media;
 mod validate;
 
 pub use builder::{LoadedGroup, WorldBuilder};
-pub(crate) use driver::patch_appearance;
 pub use driver::{build_cached, BuildCounters, Built, MeshCache, WorldLayout};
+pub(crate) use driver::{material as build_material, patch_appearance};
 
 use crate::accel::BvhSplit;
 use crate::camera::Camera;

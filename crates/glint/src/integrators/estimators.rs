@@ -11,6 +11,8 @@ use crate::math::{Ray, Rgb, Vec3};
 use crate::sampling::{power_heuristic, Sampler};
 use crate::world::{SurfaceInteraction, World};
 
+use super::observe::PathObserver;
+
 /// The last scattering event of a path: the density its sampled direction had, whether it
 /// was delta (or could not have been sampled by lights), and where it was.
 #[derive(Clone, Copy, Debug)]
@@ -24,8 +26,8 @@ pub(crate) struct PrevEvent {
 /// point (its first coordinate picks the light and, rescaled, drives the point with the
 /// second, as Mitsuba does: the sampler's 2D stratification then holds within each light's
 /// share of the samples); `None` without lights, or when the sample carries nothing. The
-/// second value is the probability of choosing the light.
-pub(crate) fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
+/// second value is the probability of choosing the light, the third its index.
+pub(crate) fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32, u32)> {
     if !scene.can_choose_lights() {
         return None;
     }
@@ -35,7 +37,7 @@ pub(crate) fn sample_light(scene: &World, p: Vec3, rng: &mut Sampler) -> Option<
     if !(ls.pdf > 0.0) || ls.radiance.is_black() {
         return None;
     }
-    Some((ls, choice.pmf))
+    Some((ls, choice.pmf, choice.index as u32))
 }
 
 /// MIS weight of an emitter reached by a sampled direction (`light_pdf`, the density light
@@ -60,6 +62,7 @@ pub(crate) fn add_environment(
     prev: &PrevEvent,
     throughput: Rgb,
     l: &mut Rgb,
+    observer: &mut impl PathObserver,
 ) {
     for &li_idx in &scene.environment_lights {
         let light = &scene.lights[li_idx as usize];
@@ -69,6 +72,7 @@ pub(crate) fn add_environment(
         }
         let w = emitter_weight(strategy, prev, || scene.light_pdf(prev.p, li_idx, 0, ray.dir, ray.origin, ray.dir));
         *l += throughput * le * w;
+        observer.emission(li_idx, throughput, le, w);
     }
 }
 
@@ -84,11 +88,13 @@ pub(crate) fn add_emitted(
     prev: &PrevEvent,
     throughput: Rgb,
     l: &mut Rgb,
+    observer: &mut impl PathObserver,
 ) {
     let le = scene.emitted(si, ray.dir);
     if !le.is_black() {
         let w = emitter_weight(strategy, prev, || scene.light_pdf(prev.p, li_idx, si.prim, ray.dir, si.p, si.ng));
         *l += throughput * le * w;
+        observer.emission(li_idx, throughput, le, w);
     }
 }
 

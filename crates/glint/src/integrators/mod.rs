@@ -6,6 +6,7 @@
 mod direct;
 mod estimators;
 mod first_hit;
+mod observe;
 mod path;
 mod path_batch;
 mod surface;
@@ -17,7 +18,10 @@ mod whitted;
 pub use crate::describe::IntegratorDesc as Integrator;
 pub use crate::describe::{DirectSettings, PathSettings, Strategy, VolpathSettings, WhittedSettings};
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
+pub(crate) use observe::{NextEvent, PathObserver, Scattering};
+pub(crate) use path::{li as path_li, PathState};
 pub use path_batch::CameraSample;
+pub(crate) use surface::transmittance;
 
 use crate::materials::ShadedBsdf;
 use crate::math::{offset_origin, Frame, Ray, Rgb, Vec3};

@@ -10,6 +10,7 @@
 //! same order, so a path's radiance is the same bits either way.
 
 use super::estimators::{add_emitted, add_environment, sample_light, survives_roulette, PrevEvent};
+use super::observe::{NextEvent, PathObserver, Scattering, Unobserved};
 use super::surface::{passes_mask, transmittance};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
@@ -120,13 +121,27 @@ impl PathState {
     /// One vertex: emission at `hit`, then (unless the path ends there) a shadow ray for
     /// next-event estimation and the next ray by sampling the BSDF. Clears `tracing` when the
     /// path ends. The caller resolves `shadow` before the next step.
+    #[inline]
     pub fn step(&mut self, s: &PathSettings, scene: &World, hit: Option<Hit>, rng: &mut Sampler, c: &mut Counters) {
+        self.step_observed(s, scene, hit, rng, c, &mut Unobserved);
+    }
+
+    /// [`PathState::step`], showing `observer` what the vertex does (see `observe`).
+    pub(crate) fn step_observed<O: PathObserver>(
+        &mut self,
+        s: &PathSettings,
+        scene: &World,
+        hit: Option<Hit>,
+        rng: &mut Sampler,
+        c: &mut Counters,
+        observer: &mut O,
+    ) {
         self.tracing = false;
         self.depth += 1;
         let ray = self.ray;
         let Some(hit) = hit else {
             if !(self.depth == 1 && s.hide_emitters) {
-                add_environment(scene, &ray, s.strategy, &self.prev, self.throughput, &mut self.l);
+                add_environment(scene, &ray, s.strategy, &self.prev, self.throughput, &mut self.l, observer);
             }
             return;
         };
@@ -134,7 +149,7 @@ impl PathState {
 
         if let Some(li_idx) = si.light {
             if !(self.depth == 1 && s.hide_emitters) {
-                add_emitted(scene, &si, &ray, li_idx, s.strategy, &self.prev, self.throughput, &mut self.l);
+                add_emitted(scene, &si, &ray, li_idx, s.strategy, &self.prev, self.throughput, &mut self.l, observer);
             }
         }
         // A masked surface lets the path through unscattered with probability 1 - opacity.
@@ -157,7 +172,7 @@ impl PathState {
 
         // Next-event estimation: one light, chosen by the scene's light distribution.
         if s.strategy != Strategy::Bsdf && !bsdf.is_delta() {
-            if let Some((ls, pick_pmf)) = sample_light(scene, si.p, rng) {
+            if let Some((ls, pick_pmf, light)) = sample_light(scene, si.p, rng) {
                 let wi = frame.to_local(ls.wi);
                 let f = bsdf.eval(wo, wi);
                 if !f.is_black() {
@@ -168,6 +183,20 @@ impl PathState {
                     } else {
                         power_heuristic(light_pdf, bsdf.pdf(wo, wi))
                     };
+                    let throughput = self.throughput;
+                    let (si, bsdf, ls) = (&si, &bsdf, &ls);
+                    observer.next_event(&NextEvent {
+                        si,
+                        bsdf,
+                        wo,
+                        wi,
+                        ls,
+                        light,
+                        throughput,
+                        f,
+                        mis_weight,
+                        light_pdf,
+                    });
                     self.shadow = Some(ShadowQuery {
                         ray: shadow_ray(&si, ls.wi, ls.dist),
                         contribution: self.throughput * f * ls.radiance,
@@ -187,6 +216,7 @@ impl PathState {
         if bs.weight.is_black() {
             return;
         }
+        observer.scattering(&Scattering { si: &si, bsdf: &bsdf, wo, wi: bs.wi, delta: bs.delta });
         self.throughput *= bs.weight;
         self.eta_scale *= bs.eta * bs.eta;
         let wi_world = frame.to_world(bs.wi);

@@ -23,6 +23,7 @@
 //! rays' transmittance by ratio tracking, both against the grid's majorant.
 
 use super::estimators::{add_emitted, add_environment, sample_light, survives_roulette, PrevEvent};
+use super::observe::Unobserved;
 use super::path::MAX_PATH_DEPTH;
 use super::surface::opacity;
 use super::{shading, shadow_ray, spawn_ray, Counters};
@@ -168,7 +169,15 @@ impl<'a> VolPath<'a> {
     /// The ray left the scene: what the environment sends back along it.
     fn escape(&mut self) {
         if !(self.depth == 0 && self.s.hide_emitters) {
-            add_environment(self.scene, &self.ray, Strategy::Mis, &self.prev, self.throughput, &mut self.l);
+            add_environment(
+                self.scene,
+                &self.ray,
+                Strategy::Mis,
+                &self.prev,
+                self.throughput,
+                &mut self.l,
+                &mut Unobserved,
+            );
         }
     }
 
@@ -188,7 +197,17 @@ impl<'a> VolPath<'a> {
                 self.ray = spawn_ray(&si, self.ray.dir);
                 return true;
             }
-            add_emitted(scene, &si, &self.ray, li_idx, Strategy::Mis, &self.prev, self.throughput, &mut self.l);
+            add_emitted(
+                scene,
+                &si,
+                &self.ray,
+                li_idx,
+                Strategy::Mis,
+                &self.prev,
+                self.throughput,
+                &mut self.l,
+                &mut Unobserved,
+            );
         }
 
         // A masked surface lets the path through unscattered with probability 1 - opacity:
@@ -270,7 +289,7 @@ fn add_light_at_surface(
     c: &mut Counters,
 ) {
     let (si, bsdf, wo) = (at.si, at.bsdf, at.wo);
-    let Some((ls, pick_pmf)) = sample_light(scene, si.p, rng) else {
+    let Some((ls, pick_pmf, _)) = sample_light(scene, si.p, rng) else {
         return;
     };
     let wi = at.frame.to_local(ls.wi);
@@ -307,7 +326,7 @@ fn light_at_medium_point(
     rng: &mut Sampler,
     c: &mut Counters,
 ) -> Rgb {
-    let Some((ls, pick_pmf)) = sample_light(scene, p, rng) else {
+    let Some((ls, pick_pmf, _)) = sample_light(scene, p, rng) else {
         return Rgb::BLACK;
     };
     let phase = m.phase.eval(wo, ls.wi);

@@ -14,6 +14,7 @@ pub use crate::sampling::PixelFilter;
 pub use aov::{Aov, AovImage};
 pub use checkpoint::{content_hash, read_film, write_film, ContentHash, FilmMeta};
 pub use film::{Block, Film, PixelSums, Rect};
+pub(crate) use passes::camera_sample;
 pub use passes::{relative_error, render_passes, Adaptive, PassOutcome, PassRequest};
 
 use crate::integrators::Integrator;

@@ -250,15 +250,8 @@ impl PassJob<'_> {
 
     /// The camera ray of sample `s` of pixel (x, y), and its sampler for the integrator.
     fn camera_sample(&self, x: u32, y: u32, s: u32) -> (SampleOrigin, CameraSample) {
-        let (scene, settings) = (self.scene, self.settings);
-        let pixel = y as u64 * scene.camera.width as u64 + x as u64;
-        let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
-        // Uniform in the pixel; a splatting filter spreads the sample over its neighbours.
-        let u = rng.next_2d();
-        let (px, py) = (x as f32 + 0.5 + (u[0] - 0.5), y as f32 + 0.5 + (u[1] - 0.5));
-        let lens = rng.next_2d();
-        let ray = scene.camera.generate_ray(px, py, lens);
-        (SampleOrigin { index: 0, px, py }, CameraSample { ray, sampler: rng })
+        let ([px, py], camera) = camera_sample(self.scene, self.settings, x, y, s);
+        (SampleOrigin { index: 0, px, py }, camera)
     }
 
     /// Traces the wave's paths together and records them in the order they were queued.
@@ -326,6 +319,26 @@ impl PassJob<'_> {
             }
         }
     }
+}
+
+/// The camera ray of sample `s` of pixel (x, y), its position on the film, and its sampler
+/// for the integrator, past the camera's dimensions. A function of (seed, pixel, sample
+/// index) alone: calling it again gives the same ray and the same random numbers after it.
+pub(crate) fn camera_sample(
+    scene: &World,
+    settings: &RenderSettings,
+    x: u32,
+    y: u32,
+    s: u32,
+) -> ([f32; 2], CameraSample) {
+    let pixel = y as u64 * scene.camera.width as u64 + x as u64;
+    let mut rng = Sampler::new(settings.sampler, settings.seed, pixel, s);
+    // Uniform in the pixel; a splatting filter spreads the sample over its neighbours.
+    let u = rng.next_2d();
+    let (px, py) = (x as f32 + 0.5 + (u[0] - 0.5), y as f32 + 0.5 + (u[1] - 0.5));
+    let lens = rng.next_2d();
+    let ray = scene.camera.generate_ray(px, py, lens);
+    ([px, py], CameraSample { ray, sampler: rng })
 }
 
 /// Where a camera sample lands: its pixel (index in the band) and its film position.

@@ -75,9 +75,18 @@ impl Slot<'_> {
 
 /// What an edit changes in the built world.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Effect {
+pub(crate) enum Effect {
     Appearance,
     Transform(usize),
+}
+
+/// The object of the description a parameter belongs to (an index into its list).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Owner {
+    Material(usize),
+    Shape(usize),
+    Light(usize),
+    Camera,
 }
 
 fn light_slots(l: &mut LightKind) -> Vec<(&'static str, Slot<'_>)> {
@@ -95,19 +104,29 @@ fn light_slots(l: &mut LightKind) -> Vec<(&'static str, Slot<'_>)> {
 
 /// Every parameter of the description with its slot and effect, in a fixed order.
 fn slots(desc: &mut SceneDesc) -> Vec<(String, Slot<'_>, Effect)> {
+    owned_slots(desc).into_iter().map(|(name, slot, effect, _)| (name, slot, effect)).collect()
+}
+
+/// [`slots`], each with the object it belongs to.
+pub(crate) fn owned_slots(desc: &mut SceneDesc) -> Vec<(String, Slot<'_>, Effect, Owner)> {
     let mut out = Vec::new();
-    for m in &mut desc.materials {
+    for (i, m) in desc.materials.iter_mut().enumerate() {
         let name = m.name.clone();
         for (field, slot) in m.model.slots() {
-            out.push((format!("materials.{name}.{field}"), slot, Effect::Appearance));
+            out.push((format!("materials.{name}.{field}"), slot, Effect::Appearance, Owner::Material(i)));
         }
     }
     for (i, s) in desc.shapes.iter_mut().enumerate() {
         // A uniform emitted radiance is editable (a textured one, as a material's texture, not).
         if let Some(Emission { radiance: TextureDesc::Constant { color }, .. }) = &mut s.emission {
-            out.push((format!("shapes.{i}.emission"), Slot::Color(color), Effect::Appearance));
+            out.push((format!("shapes.{i}.emission"), Slot::Color(color), Effect::Appearance, Owner::Shape(i)));
         }
-        out.push((format!("shapes.{i}.to_world"), Slot::Matrix(&mut s.to_world), Effect::Transform(i)));
+        out.push((
+            format!("shapes.{i}.to_world"),
+            Slot::Matrix(&mut s.to_world),
+            Effect::Transform(i),
+            Owner::Shape(i),
+        ));
     }
     // A light is named by its file's name where it has one no other light shares (a glTF
     // light's), else by its index.
@@ -120,11 +139,13 @@ fn slots(desc: &mut SceneDesc) -> Vec<(String, Slot<'_>, Effect)> {
             _ => i.to_string(),
         };
         for (field, slot) in light_slots(&mut l.light) {
-            out.push((format!("lights.{label}.{field}"), slot, Effect::Appearance));
+            out.push((format!("lights.{label}.{field}"), slot, Effect::Appearance, Owner::Light(i)));
         }
     }
-    out.push(("camera.fov".to_string(), Slot::Float(&mut desc.camera.fov_degrees), Effect::Appearance));
-    out.push(("camera.to_world".to_string(), Slot::OptionalMatrix(&mut desc.camera.to_world), Effect::Appearance));
+    let camera = &mut desc.camera;
+    out.push(("camera.fov".to_string(), Slot::Float(&mut camera.fov_degrees), Effect::Appearance, Owner::Camera));
+    let to_world = Slot::OptionalMatrix(&mut camera.to_world);
+    out.push(("camera.to_world".to_string(), to_world, Effect::Appearance, Owner::Camera));
     out
 }
 

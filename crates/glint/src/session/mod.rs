@@ -33,6 +33,7 @@
 
 mod edit;
 mod files;
+mod gradient;
 mod job;
 mod outputs;
 mod overrides;

@@ -1,0 +1,126 @@
+//! The parameters a gradient render differentiates, as the adjoint pass meets them: per
+//! material and per light of the built world, which entries of the gradient they feed and
+//! how each derivative is taken.
+
+use crate::materials::{Material, ShadedBsdf, TexturePoint};
+use crate::math::{rgb, Rgb, Vec3};
+
+/// One scalar of a material parameter (a number, or one channel of a colour): the material
+/// built with that scalar moved down and up. At a vertex, the derivative of the BSDF value
+/// is `(f(plus) - f(minus)) * inv_step`, at the same texture point and directions.
+pub struct MaterialProbe {
+    /// The gradient entry it feeds.
+    pub index: usize,
+    pub minus: Material,
+    pub plus: Material,
+    /// One over the distance between the two values.
+    pub inv_step: f32,
+}
+
+impl MaterialProbe {
+    /// The derivative of the BSDF value (cosine included) towards `wo` from `wi`, tilted as
+    /// the vertex's own BSDF is by a normal or bump map.
+    #[inline]
+    pub fn derivative(&self, p: &TexturePoint, shaded: &ShadedBsdf, wo: Vec3, wi: Vec3) -> Rgb {
+        let eval = |m: &Material| ShadedBsdf { bsdf: m.bsdf_at(p), tilt: shaded.tilt }.eval(wo, wi);
+        (eval(&self.plus) - eval(&self.minus)) * self.inv_step
+    }
+}
+
+/// Which part of a light's emission a parameter is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightParam {
+    /// Channel `c` of a colour the emission is proportional to, channel by channel
+    /// (radiance, intensity, irradiance), whose value is `value`.
+    Channel { c: usize, value: Rgb },
+    /// A scale the whole emission is proportional to, of value `value`.
+    Scale { value: f32 },
+}
+
+/// A light parameter and the gradient entry it feeds.
+#[derive(Clone, Copy, Debug)]
+pub struct LightProbe {
+    pub index: usize,
+    pub param: LightParam,
+}
+
+impl LightProbe {
+    /// The derivative of emitted radiance `le` with respect to the parameter. Emission is
+    /// linear in each parameter, so it is `le` per unit of the parameter; for a colour channel
+    /// whose value is zero, the unit response is read from another channel (the light's
+    /// geometry, falloff and distance act alike on all three).
+    #[inline]
+    pub fn derivative(&self, le: Rgb) -> Rgb {
+        match self.param {
+            LightParam::Scale { value } => {
+                if value != 0.0 {
+                    le / value
+                } else {
+                    Rgb::BLACK
+                }
+            }
+            LightParam::Channel { c, value } => {
+                let (le, value) = (le.to_array(), value.to_array());
+                let unit = if value[c] != 0.0 {
+                    le[c] / value[c]
+                } else {
+                    (0..3).find(|&k| value[k] != 0.0).map_or(0.0, |k| le[k] / value[k])
+                };
+                let mut d = [0.0; 3];
+                d[c] = unit;
+                rgb(d[0], d[1], d[2])
+            }
+        }
+    }
+}
+
+/// Every parameter of a gradient render, by the material or light it belongs to.
+#[derive(Default)]
+pub struct ParamSet {
+    len: usize,
+    /// Indexed by the world's material index.
+    materials: Vec<Vec<MaterialProbe>>,
+    /// Indexed by the world's light index.
+    lights: Vec<Vec<LightProbe>>,
+}
+
+impl ParamSet {
+    /// The number of scalar gradient entries.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// A new gradient entry's index.
+    pub fn new_entry(&mut self) -> usize {
+        self.len += 1;
+        self.len - 1
+    }
+
+    pub fn add_material_probe(&mut self, material: usize, probe: MaterialProbe) {
+        if self.materials.len() <= material {
+            self.materials.resize_with(material + 1, Vec::new);
+        }
+        self.materials[material].push(probe);
+    }
+
+    pub fn add_light_probe(&mut self, light: usize, probe: LightProbe) {
+        if self.lights.len() <= light {
+            self.lights.resize_with(light + 1, Vec::new);
+        }
+        self.lights[light].push(probe);
+    }
+
+    #[inline]
+    pub fn material_probes(&self, material: u32) -> &[MaterialProbe] {
+        self.materials.get(material as usize).map_or(&[], |v| v.as_slice())
+    }
+
+    #[inline]
+    pub fn light_probes(&self, light: u32) -> &[LightProbe] {
+        self.lights.get(light as usize).map_or(&[], |v| v.as_slice())
+    }
+}

@@ -1,0 +1,201 @@
+//! Gradient renders (see `gradient`): the parameter names resolved against the scene, each
+//! turned into what the adjoint pass reads.
+
+use super::edit::{owned_slots, Owner};
+use super::Session;
+use crate::assemble::{build_material, WorldLayout};
+use crate::describe::slots::Slot;
+use crate::describe::PixelFilter;
+use crate::error::Error;
+use crate::gradient::{render_gradient, GradientJob, LightParam, LightProbe, MaterialProbe, ParamGradient, ParamSet};
+use crate::integrators::Integrator;
+use crate::materials::{MaterialDesc, SceneDesc, TextureCache, TexturePoint};
+use crate::math::Rgb;
+use crate::world::World;
+use std::sync::atomic::AtomicBool;
+
+/// A material parameter's step, relative to its size: small enough that a symmetric
+/// difference's error (the step squared, times the third derivative) is far below Monte
+/// Carlo noise, large enough that f32 rounding of the BSDF values is too.
+const RELATIVE_STEP: f32 = 1e-2;
+/// The step's floor, for parameters at or near zero.
+const MIN_STEP: f32 = 1e-3;
+
+/// Why a parameter has no gradient.
+const NOT_GEOMETRY: &str = "gradients through geometry and the camera (which move visibility) are not supported";
+
+impl Session {
+    /// The gradient of `sum(grad_image * image)` with respect to each parameter `names`
+    /// names, for the image a path-traced render of `spp` samples per pixel with `seed` and
+    /// a box filter makes (see `gradient`). `grad_image` is `width * height` colours, rows
+    /// from the top. Runs on the current rayon pool; `cancel` stops it between rows.
+    pub fn render_gradient(
+        &mut self,
+        names: &[String],
+        grad_image: &[Rgb],
+        spp: u32,
+        seed: u64,
+        cancel: &AtomicBool,
+    ) -> Result<Vec<ParamGradient>, Error> {
+        let Integrator::Path(path) = self.integrator() else {
+            return Err(Error::new(format!(
+                "gradients need the path integrator (Mitsuba's prb or path); the scene uses '{}'",
+                self.integrator().name()
+            )));
+        };
+        if self.desc.film.filter != PixelFilter::Box {
+            return Err(Error::new(
+                "gradients need the box pixel filter (each pixel the mean of its samples); set <rfilter type=\"box\"/> or \"filter\": \"box\"",
+            ));
+        }
+        if spp == 0 {
+            return Err(Error::new("spp: must be at least 1"));
+        }
+        let (w, h) = (self.desc.film.width as usize, self.desc.film.height as usize);
+        if grad_image.len() != w * h {
+            return Err(Error::new(format!("grad_image: {} pixels, but the film is {w}x{h}", grad_image.len())));
+        }
+        let world = self.world()?;
+        let layout = self.layout.as_ref().expect("a built world has a layout");
+        let mut set = ParamSet::default();
+        let mut out = Vec::new();
+        for name in names {
+            if out.iter().any(|g: &ParamGradient| &g.name == name) {
+                return Err(Error::new(format!("'{name}' is asked for twice")));
+            }
+            let shape = add_param(&mut set, &mut self.desc.clone(), &world, layout, name)?;
+            let size = shape.iter().product();
+            out.push(ParamGradient { name: name.clone(), shape, values: vec![0.0; size] });
+        }
+        let render = crate::render::RenderSettings { seed, ..self.render_settings() };
+        let job = GradientJob { world: &world, path: &path, render: &render, params: &set, grad_image, spp };
+        let sums = render_gradient(&job, cancel)?;
+        let mut next = sums.into_iter();
+        for g in &mut out {
+            for v in &mut g.values {
+                *v = next.next().expect("one sum per scalar");
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Adds the parameter `name` to the set, returning its shape.
+fn add_param(
+    set: &mut ParamSet,
+    desc: &mut SceneDesc,
+    world: &World,
+    layout: &WorldLayout,
+    name: &str,
+) -> Result<Vec<usize>, Error> {
+    let materials = desc.materials.clone();
+    let mut slots = owned_slots(desc);
+    let Some(position) = slots.iter().position(|(n, ..)| n == name) else {
+        return Err(Error::new(format!("no parameter called '{name}'")));
+    };
+    // The slot's place among its owner's, to find it again in a copy of the owner.
+    let owner = slots[position].3;
+    let rank = slots[..position].iter().filter(|s| s.3 == owner).count();
+    let (_, slot, _, _) = slots.swap_remove(position);
+    let not = |why: &str| Error::new(format!("'{name}' is not differentiable: {why}"));
+    match owner {
+        Owner::Material(m) => material_param(set, &materials[m], m, rank, name),
+        Owner::Shape(s) => {
+            let Slot::Color(value) = slot else { return Err(not(NOT_GEOMETRY)) };
+            let lights: Vec<usize> = layout.shape_instances[s]
+                .clone()
+                .filter_map(|i| world.instances[i as usize].light.map(|l| l as usize))
+                .collect();
+            colour_light_param(set, &lights, *value);
+            Ok(vec![3])
+        }
+        Owner::Light(l) => {
+            let light = layout.shape_lights as usize + l;
+            match slot {
+                Slot::Color(value) => {
+                    colour_light_param(set, &[light], *value);
+                    Ok(vec![3])
+                }
+                Slot::Float(value) => {
+                    let index = set.new_entry();
+                    set.add_light_probe(light, LightProbe { index, param: LightParam::Scale { value: *value } });
+                    Ok(vec![])
+                }
+                Slot::Matrix(_) | Slot::OptionalMatrix(_) => Err(not(NOT_GEOMETRY)),
+            }
+        }
+        Owner::Camera => Err(not(NOT_GEOMETRY)),
+    }
+}
+
+/// A colour that a light's emission is proportional to, channel by channel, on each light.
+fn colour_light_param(set: &mut ParamSet, lights: &[usize], value: Rgb) {
+    for c in 0..3 {
+        let index = set.new_entry();
+        for &light in lights {
+            set.add_light_probe(light, LightProbe { index, param: LightParam::Channel { c, value } });
+        }
+    }
+}
+
+/// Material `m`'s `rank`-th parameter: one probe per scalar.
+fn material_param(
+    set: &mut ParamSet,
+    desc: &MaterialDesc,
+    m: usize,
+    rank: usize,
+    name: &str,
+) -> Result<Vec<usize>, Error> {
+    let mut textures = TextureCache::default();
+    let built = build_material(desc, &mut textures)?;
+    if built.bsdf_at(&TexturePoint::uv([0.5, 0.5])).is_delta() {
+        return Err(Error::new(format!(
+            "'{name}' is not differentiable: material '{}' scatters only through delta lobes, which have no BSDF value to differentiate",
+            desc.name
+        )));
+    }
+    let value = |d: &mut MaterialDesc| -> Vec<f32> {
+        match d.model.slots().into_iter().nth(rank).map(|(_, s)| s) {
+            Some(Slot::Float(v)) => vec![*v],
+            Some(Slot::Color(v)) => v.to_array().to_vec(),
+            Some(Slot::Matrix(_)) | Some(Slot::OptionalMatrix(_)) | None => vec![],
+        }
+    };
+    let values = value(&mut desc.clone());
+    if values.is_empty() {
+        return Err(Error::new(format!("'{name}' is not differentiable: {NOT_GEOMETRY}")));
+    }
+    for (k, &v) in values.iter().enumerate() {
+        let step = (v.abs() * RELATIVE_STEP).max(MIN_STEP);
+        // A side the material refuses (a roughness at zero, say) is the value itself: the
+        // difference is then one-sided.
+        let mut moved = |to: f32| -> Option<(f32, crate::materials::Material)> {
+            let mut d = desc.clone();
+            match d.model.slots().into_iter().nth(rank).map(|(_, s)| s) {
+                Some(Slot::Float(x)) => *x = to,
+                Some(Slot::Color(x)) => {
+                    let mut a = x.to_array();
+                    a[k] = to;
+                    *x = crate::math::rgb(a[0], a[1], a[2]);
+                }
+                Some(Slot::Matrix(_)) | Some(Slot::OptionalMatrix(_)) | None => return None,
+            }
+            d.model.validate().ok()?;
+            Some((to, build_material(&d, &mut textures).ok()?))
+        };
+        let (lo, minus) = match moved(v - step) {
+            Some(x) => x,
+            None => (v, built.clone()),
+        };
+        let (hi, plus) = match moved(v + step) {
+            Some(x) => x,
+            None => (v, built.clone()),
+        };
+        if !(hi > lo) {
+            return Err(Error::new(format!("'{name}': the material accepts no value near {v} but {v}")));
+        }
+        let index = set.new_entry();
+        set.add_material_probe(m, MaterialProbe { index, minus, plus, inv_step: 1.0 / (hi - lo) });
+    }
+    Ok(if values.len() == 1 { vec![] } else { vec![3] })
+}
