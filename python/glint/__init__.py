@@ -42,6 +42,7 @@ __all__ = [
     "load_file",
     "read_image",
     "render",
+    "render_gradient",
     "traverse",
     "write_image",
 ]
@@ -229,6 +230,46 @@ def render(
     s.render_passes(None, time_limit, progress)
     image, layers = s.outputs(denoise)
     return RenderResult(image=image, aovs=dict(layers), spp=s.spp, stats=dict(s.stats))
+
+
+def render_gradient(
+    scene: Scene,
+    params: Sequence[str],
+    grad_image: Any,
+    spp: Optional[int] = None,
+    seed: int = 0,
+    threads: Optional[int] = None,
+) -> Dict[str, np.ndarray]:
+    """The gradient of a loss on the image with respect to scene parameters.
+
+    Given ``grad_image``, the loss's derivative with respect to each pixel and channel of
+    the image (float, shape (H, W, 3)), returns for each name in ``params`` (names as
+    ``traverse`` gives them) the gradient of ``sum(grad_image * image)``, a float64 array
+    shaped like the parameter: () for a number, (3,) for a colour. ``image`` is what
+    ``render(scene, spp=spp, seed=seed)`` makes with the scene's path integrator and a box
+    filter. So for any loss computed in numpy, PyTorch or JAX, pass its gradient with
+    respect to the image, and get its gradient with respect to the parameters (chain rule).
+
+    Path replay backpropagation (Mitsuba's ``prb``): memory does not grow with path length,
+    and the result is the same bits for any ``threads`` (fixed-point sums). Gradients flow
+    through materials and lights, not through geometry or the camera: asking for those, or
+    for a parameter of a material that only has delta lobes, raises ``SceneError``. See
+    docs/differentiable.md. Releases the GIL; Ctrl-C raises KeyboardInterrupt.
+    """
+    scene = _check_scene(scene)
+    if isinstance(params, str):
+        params = (params,)
+    names = [str(p) for p in params]
+    g = np.ascontiguousarray(np.asarray(grad_image, dtype=np.float32))
+    if g.ndim != 3:
+        raise ValueError(f"grad_image: expected shape (H, W, 3), got {g.shape}")
+    n = _check_int(spp, "spp", 1)
+    if n is None:
+        n = scene.spp
+    threads = _check_int(threads, "threads", 1)
+    if not isinstance(seed, int) or seed < 0:
+        raise ValueError(f"seed: {seed!r} is not a non-negative integer")
+    return dict(_glint.render_gradient(scene, names, g, n, seed, threads))
 
 
 #: Render overrides ``render`` and ``make_session`` take, and the type of each.

@@ -111,6 +111,14 @@ class SceneParameters(MutableMapping[str, Any]):
 
 def load_file(path: _Path, **defines: Union[str, int, float, bool]) -> Scene: ...
 def load_dict(d: Mapping[str, Any], base_dir: _Path = ".") -> Scene: ...
+def render_gradient(
+    scene: Scene,
+    params: Sequence[str],
+    grad_image: Any,
+    spp: Optional[int] = None,
+    seed: int = 0,
+    threads: Optional[int] = None,
+) -> Dict[str, np.ndarray]: ...
 def render(
     scene: Scene,
     spp: Optional[int] = None,

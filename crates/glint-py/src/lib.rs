@@ -3,6 +3,7 @@
 //! argument checks, dict scenes, `traverse` and the denoiser; see its docstrings.
 
 mod convert;
+mod gradient;
 mod images;
 mod overrides;
 mod preview;
@@ -19,6 +20,7 @@ fn _glint(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::load_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_json, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_description, m)?)?;
+    m.add_function(wrap_pyfunction!(gradient::render_gradient, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::denoise, m)?)?;

@@ -28,7 +28,7 @@ use std::time::{Duration, Instant};
 
 /// How often the waiting thread takes the GIL to look for Ctrl-C (and maybe call the
 /// progress callback): short enough that Ctrl-C feels immediate.
-const SIGNAL_POLL: Duration = Duration::from_millis(50);
+pub(crate) const SIGNAL_POLL: Duration = Duration::from_millis(50);
 /// The progress callback is called no more often than this.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(250);
 
@@ -66,18 +66,18 @@ fn block_tuples(film: &Film) -> Vec<BlockTuple> {
 
 /// Set when the render thread is done; the waiting thread sleeps on it.
 #[derive(Default)]
-struct DoneSignal {
+pub(crate) struct DoneSignal {
     done: Mutex<bool>,
     cv: Condvar,
 }
 
 impl DoneSignal {
-    fn set(&self) {
+    pub(crate) fn set(&self) {
         *self.done.lock().unwrap_or_else(|e| e.into_inner()) = true;
         self.cv.notify_all();
     }
     /// Waits up to `t`; true once done.
-    fn wait(&self, t: Duration) -> bool {
+    pub(crate) fn wait(&self, t: Duration) -> bool {
         let g = self.done.lock().unwrap_or_else(|e| e.into_inner());
         let (g, _) = self.cv.wait_timeout_while(g, t, |d| !*d).unwrap_or_else(|e| e.into_inner());
         *g

@@ -19,7 +19,7 @@ use crate::describe::{CameraDesc, Geometry, LightKind, MaterialRef, Matrix4};
 use crate::error::{Error, SourceLoc};
 use crate::lights::{Light, ProjectedKind, ProjectedLight};
 use crate::materials::SceneDesc;
-use crate::materials::{Texture, TextureCache};
+use crate::materials::{Bitmap, Texture, TextureCache};
 use crate::math::{Aabb, Frame, Mat4, Transform, Vec3};
 use crate::world::World;
 use std::collections::BTreeSet;
@@ -85,9 +85,12 @@ fn add_light(b: &mut WorldBuilder, l: &LightKind, textures: &mut TextureCache) -
         }
         LightKind::Directional { direction, irradiance } => b.add_directional(*direction, *irradiance),
         LightKind::Constant { radiance } => b.add_constant_environment(*radiance),
-        LightKind::EnvMap { file, scale, to_world } => {
-            let image = textures.bitmap(file, true, &SourceLoc::default())?;
-            b.add_envmap((*image).clone(), *scale, transform_of(to_world)?);
+        LightKind::EnvMap { file, scale, to_world, texels } => {
+            let image = match texels {
+                Some(t) => Bitmap::of_texels(t),
+                None => (*textures.bitmap(file, true, &SourceLoc::default())?).clone(),
+            };
+            b.add_envmap(image, *scale, transform_of(to_world)?);
         }
         LightKind::TexturedSpot { to_world, intensity, cutoff_degrees, beam_degrees, texture } => {
             b.add_light(Light::Projected(Arc::new(ProjectedLight {

@@ -197,19 +197,31 @@ impl ScalarTexture {
     }
 }
 
+/// An image's texels given as data (by an edit, such as an optimiser's step), replacing
+/// those of its file: linear RGB, `width * height` of them, rows from the top.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Texels {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<Rgb>,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "lowercase")]
 pub enum TextureDesc {
     Constant {
         color: Rgb,
     },
-    /// An image file; PNG/JPEG are sRGB-decoded unless `raw`.
+    /// An image file; PNG/JPEG are sRGB-decoded unless `raw`. `texels`, where set, replace
+    /// the file's.
     Bitmap {
         file: PathBuf,
         raw: bool,
         uv_scale: [f32; 2],
         uv_offset: [f32; 2],
         loc: SourceLoc,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texels: Option<Texels>,
     },
     Checkerboard {
         color0: Rgb,
@@ -452,10 +464,13 @@ pub enum LightKind {
         radiance: Rgb,
     },
     /// A latitude-longitude environment map.
+    /// `texels`, where set, replace the file's.
     EnvMap {
         file: PathBuf,
         scale: f32,
         to_world: Matrix4,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texels: Option<Texels>,
     },
     /// A spot light projecting a texture (Mitsuba's `spot` with `texture`), at the origin
     /// of `to_world` looking along its +z; its rotation about that axis turns the texture.
@@ -768,7 +783,7 @@ mod tests {
             });
         }
         d.lights.push(LightDesc {
-            light: LightKind::EnvMap { file: "sky.exr".into(), scale: 1.0, to_world: IDENTITY },
+            light: LightKind::EnvMap { file: "sky.exr".into(), scale: 1.0, to_world: IDENTITY, texels: None },
             name: None,
             loc: SourceLoc::default(),
         });

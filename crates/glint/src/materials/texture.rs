@@ -72,6 +72,29 @@ impl Bitmap {
         [dfdx * self.width as f32, dfdy * self.height as f32]
     }
 
+    /// An image of texels given as data.
+    pub fn of_texels(t: &crate::describe::Texels) -> Bitmap {
+        Bitmap { width: t.width, height: t.height, pixels: t.pixels.clone() }
+    }
+
+    /// The texels [`Bitmap::eval`] blends at `uv` (indices into `pixels`) and their weights.
+    pub fn taps(&self, uv: [f32; 2]) -> [(usize, f32); 4] {
+        let x = uv[0] * self.width as f32 - 0.5;
+        let y = uv[1] * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let at = |x: i64, y: i64| {
+            y.rem_euclid(self.height as i64) as usize * self.width + x.rem_euclid(self.width as i64) as usize
+        };
+        [
+            (at(x0, y0), (1.0 - fx) * (1.0 - fy)),
+            (at(x0 + 1, y0), fx * (1.0 - fy)),
+            (at(x0, y0 + 1), (1.0 - fx) * fy),
+            (at(x0 + 1, y0 + 1), fx * fy),
+        ]
+    }
+
     pub fn mean(&self) -> Rgb {
         let s = self.pixels.iter().fold(Rgb::BLACK, |a, &p| a + p);
         s / self.pixels.len().max(1) as f32

@@ -31,7 +31,10 @@ impl TextureCache {
     pub(crate) fn texture(&mut self, t: &TextureDesc) -> Result<Texture, Error> {
         Ok(match t {
             TextureDesc::Constant { color } => Texture::Constant(*color),
-            TextureDesc::Bitmap { file, raw, uv_scale, uv_offset, loc } => {
+            TextureDesc::Bitmap { texels: Some(t), uv_scale, uv_offset, .. } => {
+                Texture::Bitmap { image: Arc::new(Bitmap::of_texels(t)), uv_scale: *uv_scale, uv_offset: *uv_offset }
+            }
+            TextureDesc::Bitmap { file, raw, uv_scale, uv_offset, loc, texels: None } => {
                 Texture::Bitmap { image: self.bitmap(file, *raw, loc)?, uv_scale: *uv_scale, uv_offset: *uv_offset }
             }
             TextureDesc::Checkerboard { color0, color1, uv_scale, uv_offset } => {

@@ -385,6 +385,7 @@ fn texture_of(ctx: &Ctx, json_path: &str, t: &JsonTexture) -> TextureDesc {
             uv_scale: uv_scale.unwrap_or([1.0, 1.0]),
             uv_offset: [0.0, 0.0],
             loc: ctx.loc(json_path),
+            texels: None,
         },
         JsonTexture::Checker { checkerboard, uv_scale } => TextureDesc::Checkerboard {
             color0: checkerboard[0].rgb(),
@@ -839,6 +840,7 @@ fn light_of(ctx: &Ctx, at: &str, l: &JsonLight) -> Result<LightKind, Error> {
             file: ctx.resolve(file),
             scale: scale.unwrap_or(1.0),
             to_world: transform_of(transform).map_err(|e| ctx.err(&format!("{at}/transform"), e))?,
+            texels: None,
         },
     })
 }

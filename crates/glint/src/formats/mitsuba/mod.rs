@@ -343,7 +343,7 @@ impl<'a> Reader<'a> {
                 let raw = tp.bool("raw", false)?;
                 let _ = tp.string("filter_type");
                 let _ = tp.string("wrap_mode");
-                Ok(TextureDesc::Bitmap { file: path, raw, uv_scale, uv_offset, loc: e.loc() })
+                Ok(TextureDesc::Bitmap { file: path, raw, uv_scale, uv_offset, loc: e.loc(), texels: None })
             }
             "checkerboard" => Ok(TextureDesc::Checkerboard {
                 color0: tp.rgb("color0", Rgb::splat(0.4))?,
@@ -564,6 +564,7 @@ impl<'a> Reader<'a> {
                     file: self.resolve_file(el, file),
                     scale: p.float("scale", 1.0)?,
                     to_world: matrix(&to_world),
+                    texels: None,
                 }
             }
             "area" => return Err(el.err("an area emitter must be nested inside a <shape>")),
