@@ -92,6 +92,10 @@ pub struct CameraDesc {
     /// Perspective (the field of view and lens above) or orthographic (they are unused).
     #[serde(default)]
     pub projection: Projection,
+    /// The file's id for the sensor (Mitsuba's `<sensor id>`), by which Mitsuba's names of
+    /// its parameters are accepted as aliases (see `session::edit`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -304,6 +308,10 @@ pub struct ShapeDesc {
     /// [`SceneDesc::media`]; a shape with neither leaves the medium of a ray unchanged.
     #[serde(default, skip_serializing_if = "ShapeMedia::is_none")]
     pub media: ShapeMedia,
+    /// The file's id for the shape (Mitsuba's `<shape id>`, JSON's `id`), by which
+    /// `traverse` names its parameters; `None` where the file gives none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
 }
 
 /// The media on the two sides of a shape (Mitsuba's `interior` and `exterior`).
@@ -429,8 +437,8 @@ pub struct MeshData {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LightDesc {
     pub light: LightKind,
-    /// The file's name for the light (a glTF light's `name`), by which `traverse` names
-    /// its parameters; `None` where the format names none.
+    /// The file's name for the light (a glTF light's `name`, a Mitsuba emitter's `id`), by
+    /// which `traverse` names its parameters; `None` where the format names none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     pub loc: SourceLoc,
@@ -695,6 +703,7 @@ impl Default for CameraDesc {
             loc: SourceLoc::default(),
             medium: None,
             projection: Projection::Perspective,
+            id: None,
         }
     }
 }
@@ -739,6 +748,7 @@ mod tests {
             flip_normals: false,
             loc: SourceLoc::new("a.json", 3, 5),
             media: ShapeMedia::default(),
+            id: Some("ball".into()),
         });
         let text = serde_json::to_string(&d).unwrap();
         let back: SceneDesc = serde_json::from_str(&text).unwrap();
@@ -780,6 +790,7 @@ mod tests {
                 flip_normals: false,
                 loc: SourceLoc::default(),
                 media: ShapeMedia::default(),
+                id: None,
             });
         }
         d.lights.push(LightDesc {
@@ -796,6 +807,7 @@ mod tests {
             flip_normals: false,
             loc: SourceLoc::default(),
             media: ShapeMedia::default(),
+            id: None,
         });
         d.lights.push(LightDesc {
             light: LightKind::TexturedSpot {

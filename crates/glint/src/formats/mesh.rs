@@ -38,6 +38,7 @@ pub fn describe(path: &Path) -> Result<SceneDesc, Error> {
         flip_normals: false,
         loc: loc.clone(),
         media: Default::default(),
+        id: None,
     });
     d.lights.push(LightDesc { light: LightKind::Constant { radiance: Rgb::splat(0.4) }, name: None, loc: loc.clone() });
     d.lights.push(LightDesc {

@@ -1,7 +1,7 @@
 //! Gradient renders (see `gradient`): the parameter names resolved against the scene, each
 //! turned into what the adjoint pass reads.
 
-use super::edit::{owned_slots, Owner};
+use super::edit::{resolve_param_name, slots, Owner};
 use super::Session;
 use crate::assemble::{build_material, WorldLayout};
 use crate::describe::slots::Slot;
@@ -59,11 +59,15 @@ impl Session {
         let layout = self.layout.as_ref().expect("a built world has a layout");
         let mut set = ParamSet::default();
         let mut out = Vec::new();
+        let mut desc = self.desc.clone();
+        let mut canonical = Vec::new();
         for name in names {
-            if out.iter().any(|g: &ParamGradient| &g.name == name) {
+            let c = resolve_param_name(&mut desc, name)?;
+            if canonical.contains(&c) {
                 return Err(Error::new(format!("'{name}' is asked for twice")));
             }
-            let shape = add_param(&mut set, &mut self.desc.clone(), &world, layout, name)?;
+            canonical.push(c.clone());
+            let shape = add_param(&mut set, &mut desc, &world, layout, &c)?;
             let size = shape.iter().product();
             out.push(ParamGradient { name: name.clone(), shape, values: vec![0.0; size] });
         }
@@ -89,14 +93,14 @@ fn add_param(
     name: &str,
 ) -> Result<Vec<usize>, Error> {
     let materials = desc.materials.clone();
-    let mut slots = owned_slots(desc);
-    let Some(position) = slots.iter().position(|(n, ..)| n == name) else {
+    let mut entries = slots(desc);
+    let Some(position) = entries.iter().position(|e| e.name == name) else {
         return Err(Error::new(format!("no parameter called '{name}'")));
     };
     // The slot's place among its owner's, to find it again in a copy of the owner.
-    let owner = slots[position].3;
-    let rank = slots[..position].iter().filter(|s| s.3 == owner).count();
-    let (_, slot, _, _) = slots.swap_remove(position);
+    let owner = entries[position].owner;
+    let rank = entries[..position].iter().filter(|e| e.owner == owner).count();
+    let slot = entries.swap_remove(position).slot;
     let not = |why: &str| Error::new(format!("'{name}' is not differentiable: {why}"));
     match owner {
         Owner::Material(m) => material_param(set, &materials[m], m, rank, name),

@@ -31,7 +31,8 @@
 //! # }
 //! ```
 
-mod edit;
+// Crate-visible for `edit::resolve_param_name` (gradient code names parameters too).
+pub(crate) mod edit;
 mod files;
 mod gradient;
 mod job;

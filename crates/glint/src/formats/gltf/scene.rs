@@ -317,6 +317,9 @@ pub fn place(
                         d.meshes.len() - 1
                     });
                     let mut s = shape(mesh_index, to_world, material, emission.clone(), &loc);
+                    // The node's name, for `traverse` (shared by a node's primitives and
+                    // instances, which are then named by index).
+                    s.id = node.get("name").and_then(Value::as_str).map(str::to_string);
                     // A volume's absorbing medium inside; outside, none (vacuum).
                     s.media.interior = interior;
                     d.shapes.push(s);
@@ -358,5 +361,6 @@ fn shape(
         flip_normals: false,
         loc: loc.clone(),
         media: Default::default(),
+        id: None,
     }
 }

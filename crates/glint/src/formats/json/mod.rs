@@ -241,6 +241,9 @@ struct JsonShape {
     p0: Option<[f32; 3]>,
     #[serde(default)]
     p1: Option<[f32; 3]>,
+    /// Names the shape's parameters in `traverse`.
+    #[serde(default)]
+    id: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -571,6 +574,7 @@ fn camera_of(ctx: &Ctx, cam: &JsonCamera) -> Result<CameraDesc, Error> {
         loc: ctx.loc("camera"),
         medium: None,
         projection,
+        id: None,
     })
 }
 
@@ -765,6 +769,7 @@ fn shape_of(ctx: &Ctx, desc: &SceneDesc, i: usize, s: &JsonShape, medium_ref: &M
             interior: medium_ref(&s.interior, &format!("{at}/interior"))?,
             exterior: medium_ref(&s.exterior, &format!("{at}/exterior"))?,
         },
+        id: s.id.clone(),
     })
 }
 
@@ -785,6 +790,7 @@ fn gltf_group(ctx: &Ctx, i: usize, s: &JsonShape) -> Result<(PathBuf, SceneDesc)
         ("exterior", s.exterior.is_some()),
         ("p0", s.p0.is_some()),
         ("p1", s.p1.is_some()),
+        ("id", s.id.is_some()),
     ];
     if let Some((key, _)) = given.iter().find(|(_, set)| *set) {
         return Err(ctx.err(
@@ -868,5 +874,38 @@ fn strip_position(msg: &str) -> String {
     match msg.rfind(" at line ") {
         Some(i) => msg[..i].to_string(),
         None => msg.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::materials::SceneDesc;
+    use std::path::Path;
+
+    /// A scene of one shape object (given as JSON text).
+    fn read(shape: &str) -> Result<SceneDesc, String> {
+        let text = format!(
+            "{{\n\"camera\": {{\"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"fov\": 40}},\n\
+             \"film\": {{\"width\": 4, \"height\": 4}},\n\
+             \"shapes\": [\n{shape}\n]\n}}"
+        );
+        super::read(Path::new("s.json"), &text).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_shape_keeps_its_id() {
+        let d = read(r#"{"type": "sphere", "id": "ball"}"#).unwrap();
+        assert_eq!(d.shapes[0].id.as_deref(), Some("ball"));
+        assert_eq!(read(r#"{"type": "sphere"}"#).unwrap().shapes[0].id, None);
+    }
+
+    #[test]
+    fn an_id_that_is_not_a_string_is_one_line_where_it_is() {
+        let e = read("{\"type\": \"sphere\",\n \"id\": 3}").unwrap_err();
+        // The key is on the shape's second line, the file's sixth.
+        assert!(e.starts_with("s.json:6:") && e.contains("expected a string"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        let e = read(r#"{"type": "gltf", "file": "a.glb", "id": "x"}"#).unwrap_err();
+        assert!(e.contains("'id' does not apply"), "{e}");
     }
 }

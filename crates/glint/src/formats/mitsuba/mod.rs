@@ -504,6 +504,8 @@ impl<'a> Reader<'a> {
             flip_normals,
             loc: el.loc(),
             media,
+            // A group's shape is drawn once per instance: its id names none of them.
+            id: if instance_to_world.is_none() { el.attr("id").map(str::to_string) } else { None },
         });
         Ok(())
     }
@@ -571,7 +573,7 @@ impl<'a> Reader<'a> {
             other => return Err(el.err(format!("emitter plugin '{other}' is not supported"))),
         };
         self.warn_unused(&p);
-        self.lights.push(LightDesc { light, name: None, loc: el.loc() });
+        self.lights.push(LightDesc { light, name: el.attr("id").map(str::to_string), loc: el.loc() });
         Ok(())
     }
 
@@ -674,6 +676,7 @@ impl<'a> Reader<'a> {
             loc: el.loc(),
             medium: self.sensor_medium(el)?,
             projection: if orthographic { Projection::Orthographic } else { Projection::Perspective },
+            id: el.attr("id").map(str::to_string),
         };
         // Perspective cameras accept (and, like Mitsuba, ignore) a focus distance.
         let _ = p.opt_float("focus_distance")?;
