@@ -765,6 +765,7 @@ mod tests {
             uv_scale: [1.0; 2],
             uv_offset: [0.0; 2],
             loc: SourceLoc::default(),
+            texels: None,
         };
         d.materials.push(MaterialDesc {
             name: "wood".into(),
