@@ -102,14 +102,6 @@ def reference(name: str) -> dict:
     return ref
 
 
-# The skip is temporary: render_gradient is being added to glint; once it is there, this
-# skip never fires and the tests run.
-needs_gradient = pytest.mark.skipif(
-    not hasattr(glint, "render_gradient"),
-    reason="glint.render_gradient does not exist yet (differentiable rendering is being added)",
-)
-
-
 class Run:
     """glint's K seeded primal renders and K seeded gradient renders of one scene."""
 
@@ -154,7 +146,6 @@ def run_of(name: str) -> Run:
 SCENES = ["cornell", "textured", "conductor"]
 
 
-@needs_gradient
 @pytest.mark.parametrize("name", SCENES)
 def test_primal_image_mean_matches_mitsuba(name):
     r = run_of(name)
@@ -167,7 +158,6 @@ def test_primal_image_mean_matches_mitsuba(name):
     )
 
 
-@needs_gradient
 @pytest.mark.parametrize("name", SCENES)
 def test_gradients_match_mitsuba(name):
     r = run_of(name)
@@ -191,7 +181,6 @@ def test_gradients_match_mitsuba(name):
     assert not failures, f"{name}:\n" + "\n".join(failures)
 
 
-@needs_gradient
 @pytest.mark.parametrize("name", SCENES)
 def test_gradient_signs(name):
     """Raising a diffuse reflectance or a light's radiance brightens every pixel it changes
@@ -207,7 +196,6 @@ def test_gradient_signs(name):
         assert m[0] < -4 * se[0], f"alpha gradient {m[0]} +- {se[0]}: expected negative"
 
 
-@needs_gradient
 @pytest.mark.parametrize("name", SCENES)
 def test_emission_gradient_is_image_over_radiance(name):
     """The image is linear in the light's radiance: gradient * radiance = each channel's loss,

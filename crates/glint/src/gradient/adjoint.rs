@@ -1,10 +1,13 @@
 //! The adjoint pass's view of a replayed path: at each event, the adjoint radiance times
 //! the event's derivative with respect to each parameter it depends on, added to the sums.
 
+use super::params::{LightParam, LightProbe};
 use super::{fixed, ParamSet};
 use crate::integrators::{shadow_ray, transmittance, Counters, NextEvent, PathObserver, Scattering};
-use crate::math::Rgb;
-use crate::world::World;
+use crate::lights::Light;
+use crate::materials::{ShadedBsdf, TexturePoint};
+use crate::math::{rgb, Rgb, Vec3};
+use crate::world::{SurfaceInteraction, World};
 
 pub(super) struct Adjoint<'a> {
     world: &'a World,
@@ -19,67 +22,121 @@ pub(super) struct Adjoint<'a> {
     counters: Counters,
 }
 
+/// How a vertex's contribution depends on its BSDF value `f` (cosine included) towards
+/// `wo` from `wi`: channel by channel, it is `weight(df)` for a change `df` of `f`.
+struct BsdfUse<'e> {
+    si: &'e SurfaceInteraction,
+    bsdf: &'e ShadedBsdf,
+    wo: Vec3,
+    wi: Vec3,
+}
+
 impl<'a> Adjoint<'a> {
     pub fn new(world: &'a World, params: &'a ParamSet, adjoint: Rgb, total: Rgb, sums: &'a mut [i128]) -> Adjoint<'a> {
         Adjoint { world, params, adjoint, total, gathered: Rgb::BLACK, sums, counters: Counters::default() }
     }
 
-    /// Adds the adjoint times `d` (the derivative of this sample's radiance with respect
-    /// to one parameter, per channel) to entry `index`.
+    /// Adds `v` to entry `index`.
     #[inline]
-    fn add(&mut self, index: usize, d: Rgb) {
-        let a = self.adjoint;
-        let v = a.r as f64 * d.r as f64 + a.g as f64 * d.g as f64 + a.b as f64 * d.b as f64;
+    fn add_scalar(&mut self, index: usize, v: f64) {
         if v != 0.0 && v.is_finite() {
             self.sums[index] = self.sums[index].saturating_add(fixed(v));
+        }
+    }
+
+    /// The adjoint times `d`, the derivative of this sample's radiance per channel.
+    #[inline]
+    fn dot(&self, d: Rgb) -> f64 {
+        let a = self.adjoint;
+        a.r as f64 * d.r as f64 + a.g as f64 * d.g as f64 + a.b as f64 * d.b as f64
+    }
+
+    /// Differentiates a contribution through the BSDF value of `u`'s material: `weight`
+    /// turns a change of the BSDF value into a change of the sample's radiance.
+    fn through_bsdf(&mut self, u: &BsdfUse<'_>, weight: impl Fn(Rgb) -> Rgb) {
+        let params = self.params;
+        let material = u.si.material;
+        let (probes, textures) = (params.material_probes(material), params.texture_probes(material));
+        if probes.is_empty() && textures.is_empty() {
+            return;
+        }
+        let p: TexturePoint = self.world.texture_point(u.si);
+        for probe in probes {
+            let v = self.dot(weight(probe.derivative(&p, u.bsdf, u.wo, u.wi)));
+            self.add_scalar(probe.index, v);
+        }
+        for texture in textures {
+            let taps = texture.taps(p.uv);
+            for (c, probe) in texture.channels.iter().enumerate() {
+                let v = self.dot(weight(probe.derivative(&p, u.bsdf, u.wo, u.wi)));
+                for (index, w) in taps {
+                    self.add_scalar(index + c, v * w as f64);
+                }
+            }
+        }
+    }
+
+    /// Differentiates a contribution `weight * le` through light `light`'s emission `le`
+    /// along `dir`.
+    fn through_emission(&mut self, light: u32, dir: Vec3, le: Rgb, weight: Rgb) {
+        for probe in self.params.light_probes(light) {
+            match probe.param {
+                LightParam::Texels { scale } => self.through_texels(probe, light, dir, weight * scale),
+                LightParam::Channel { .. } | LightParam::Scale { .. } => {
+                    let v = self.dot(weight * probe.derivative(le));
+                    self.add_scalar(probe.index, v);
+                }
+            }
+        }
+    }
+
+    /// An environment map's texels: its emission along `dir` is `scale` times the blend of
+    /// the texels its lookup reads, channel by channel (`weight` includes the scale).
+    fn through_texels(&mut self, probe: &LightProbe, light: u32, dir: Vec3, weight: Rgb) {
+        let Some(Light::EnvMap(env)) = self.world.lights.get(light as usize) else { return };
+        let a = self.adjoint;
+        let per_channel = [a.r * weight.r, a.g * weight.g, a.b * weight.b];
+        for (texel, w) in env.taps(dir) {
+            for (c, v) in per_channel.iter().enumerate() {
+                self.add_scalar(probe.index + 3 * texel + c, *v as f64 * w as f64);
+            }
         }
     }
 }
 
 impl PathObserver for Adjoint<'_> {
-    fn emission(&mut self, light: u32, throughput: Rgb, le: Rgb, mis_weight: f32) {
+    fn emission(&mut self, light: u32, dir: Vec3, throughput: Rgb, le: Rgb, mis_weight: f32) {
         self.gathered += throughput * le * mis_weight;
-        for probe in self.params.light_probes(light) {
-            self.add(probe.index, throughput * probe.derivative(le) * mis_weight);
-        }
+        self.through_emission(light, dir, le, throughput * mis_weight);
     }
 
     fn next_event(&mut self, e: &NextEvent<'_>) {
-        let world = self.world;
-        let visible = transmittance(world, &shadow_ray(e.si, e.ls.wi, e.ls.dist), &mut self.counters);
+        let visible = transmittance(self.world, &shadow_ray(e.si, e.ls.wi, e.ls.dist), &mut self.counters);
         if !(visible > 0.0) {
             return;
         }
         let scale = e.mis_weight * visible / e.light_pdf;
         self.gathered += e.throughput * e.f * e.ls.radiance * scale;
-        let material_probes = self.params.material_probes(e.si.material);
-        if !material_probes.is_empty() {
-            let p = world.texture_point(e.si);
-            for probe in material_probes {
-                let df = probe.derivative(&p, e.bsdf, e.wo, e.wi);
-                self.add(probe.index, e.throughput * df * e.ls.radiance * scale);
-            }
-        }
-        for probe in self.params.light_probes(e.light) {
-            self.add(probe.index, e.throughput * e.f * probe.derivative(e.ls.radiance) * scale);
-        }
+        let u = BsdfUse { si: e.si, bsdf: e.bsdf, wo: e.wo, wi: e.wi };
+        let (throughput, radiance) = (e.throughput, e.ls.radiance);
+        self.through_bsdf(&u, |df| throughput * df * radiance * scale);
+        self.through_emission(e.light, e.ls.wi, e.ls.radiance, e.throughput * e.f * scale);
     }
 
     fn scattering(&mut self, e: &Scattering<'_>) {
         // A delta lobe has no BSDF value to differentiate (as in Mitsuba's prb).
-        let probes = self.params.material_probes(e.si.material);
-        if e.delta || probes.is_empty() {
+        let material = e.si.material;
+        let params = self.params;
+        if e.delta || (params.material_probes(material).is_empty() && params.texture_probes(material).is_empty()) {
             return;
         }
         let f = e.bsdf.eval(e.wo, e.wi);
         // Everything after this vertex is proportional, channel by channel, to its f.
         let rest = self.total - self.gathered;
         let ratio = |d: f32, f: f32| if f > 0.0 { d / f } else { 0.0 };
-        let p = self.world.texture_point(e.si);
-        for probe in probes {
-            let df = probe.derivative(&p, e.bsdf, e.wo, e.wi);
-            let d = crate::math::rgb(rest.r * ratio(df.r, f.r), rest.g * ratio(df.g, f.g), rest.b * ratio(df.b, f.b));
-            self.add(probe.index, d);
-        }
+        let u = BsdfUse { si: e.si, bsdf: e.bsdf, wo: e.wo, wi: e.wi };
+        self.through_bsdf(&u, |df| {
+            rgb(rest.r * ratio(df.r, f.r), rest.g * ratio(df.g, f.g), rest.b * ratio(df.b, f.b))
+        });
     }
 }

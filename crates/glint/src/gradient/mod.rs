@@ -32,7 +32,7 @@
 mod adjoint;
 mod params;
 
-pub use params::{LightParam, LightProbe, MaterialProbe, ParamSet};
+pub use params::{LightParam, LightProbe, MaterialProbe, ParamSet, TextureProbe};
 
 use crate::error::Error;
 use crate::integrators::{path_li, Counters, PathSettings, PathState};
@@ -51,7 +51,7 @@ const GRADIENT_EXTRA_BITS: i32 = 24;
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamGradient {
     pub name: String,
-    /// Empty for a number, `[3]` for a colour.
+    /// Empty for a number, `[3]` for a colour, `[height, width, 3]` for an image's texels.
     pub shape: Vec<usize>,
     pub values: Vec<f64>,
 }

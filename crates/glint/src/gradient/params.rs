@@ -27,6 +27,45 @@ impl MaterialProbe {
     }
 }
 
+/// A material's bitmap texture, per texel: `channels[c]` moves channel c of every texel,
+/// so its derivative at a vertex is that of the BSDF with respect to the texture's value
+/// there, which the bilinear lookup's weights share out among the texels it read.
+pub struct TextureProbe {
+    /// The gradient entry of texel 0's red channel; texel i's channel c is `base + 3i + c`.
+    pub base: usize,
+    pub width: usize,
+    pub height: usize,
+    /// The texture's (scale, offset) of surface uv.
+    pub uv: [[f32; 2]; 2],
+    pub channels: [MaterialProbe; 3],
+}
+
+impl TextureProbe {
+    /// The texels the lookup at surface `uv` reads, as gradient entries of their red
+    /// channels, and their weights.
+    #[inline]
+    pub fn taps(&self, uv: [f32; 2]) -> [(usize, f32); 4] {
+        let [scale, offset] = self.uv;
+        let uv = [uv[0] * scale[0] + offset[0], uv[1] * scale[1] + offset[1]];
+        let x = uv[0] * self.width as f32 - 0.5;
+        let y = uv[1] * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let at = |x: i64, y: i64| {
+            let texel =
+                y.rem_euclid(self.height as i64) as usize * self.width + x.rem_euclid(self.width as i64) as usize;
+            self.base + 3 * texel
+        };
+        [
+            (at(x0, y0), (1.0 - fx) * (1.0 - fy)),
+            (at(x0 + 1, y0), fx * (1.0 - fy)),
+            (at(x0, y0 + 1), (1.0 - fx) * fy),
+            (at(x0 + 1, y0 + 1), fx * fy),
+        ]
+    }
+}
+
 /// Which part of a light's emission a parameter is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LightParam {
@@ -35,6 +74,9 @@ pub enum LightParam {
     Channel { c: usize, value: Rgb },
     /// A scale the whole emission is proportional to, of value `value`.
     Scale { value: f32 },
+    /// An environment map's texels (the probe's index is texel 0's red channel; texel i's
+    /// channel c is `index + 3i + c`), the map's scale `scale`.
+    Texels { scale: f32 },
 }
 
 /// A light parameter and the gradient entry it feeds.
@@ -52,6 +94,8 @@ impl LightProbe {
     #[inline]
     pub fn derivative(&self, le: Rgb) -> Rgb {
         match self.param {
+            // Per texel: see the adjoint pass.
+            LightParam::Texels { .. } => Rgb::BLACK,
             LightParam::Scale { value } => {
                 if value != 0.0 {
                     le / value
@@ -80,6 +124,7 @@ pub struct ParamSet {
     len: usize,
     /// Indexed by the world's material index.
     materials: Vec<Vec<MaterialProbe>>,
+    textures: Vec<Vec<TextureProbe>>,
     /// Indexed by the world's light index.
     lights: Vec<Vec<LightProbe>>,
 }
@@ -96,8 +141,25 @@ impl ParamSet {
 
     /// A new gradient entry's index.
     pub fn new_entry(&mut self) -> usize {
-        self.len += 1;
-        self.len - 1
+        self.new_entries(1)
+    }
+
+    /// `n` new consecutive gradient entries, the first's index.
+    pub fn new_entries(&mut self, n: usize) -> usize {
+        self.len += n;
+        self.len - n
+    }
+
+    pub fn add_texture_probe(&mut self, material: usize, probe: TextureProbe) {
+        if self.textures.len() <= material {
+            self.textures.resize_with(material + 1, Vec::new);
+        }
+        self.textures[material].push(probe);
+    }
+
+    #[inline]
+    pub fn texture_probes(&self, material: u32) -> &[TextureProbe] {
+        self.textures.get(material as usize).map_or(&[], |v| v.as_slice())
     }
 
     pub fn add_material_probe(&mut self, material: usize, probe: MaterialProbe) {

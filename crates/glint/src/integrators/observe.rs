@@ -38,8 +38,8 @@ pub(crate) struct Scattering<'a> {
 
 pub(crate) trait PathObserver {
     /// Light `light` added `throughput * le * mis_weight` to the path's radiance (an area
-    /// light hit, or an environment light seen by an escaped ray).
-    fn emission(&mut self, light: u32, throughput: Rgb, le: Rgb, mis_weight: f32);
+    /// light hit, or an environment light seen by an escaped ray), along direction `dir`.
+    fn emission(&mut self, light: u32, dir: Vec3, throughput: Rgb, le: Rgb, mis_weight: f32);
     /// Next-event estimation chose a light; its shadow ray is the observer's to trace.
     fn next_event(&mut self, e: &NextEvent<'_>);
     fn scattering(&mut self, e: &Scattering<'_>);
@@ -50,7 +50,7 @@ pub(crate) struct Unobserved;
 
 impl PathObserver for Unobserved {
     #[inline(always)]
-    fn emission(&mut self, _light: u32, _throughput: Rgb, _le: Rgb, _mis_weight: f32) {}
+    fn emission(&mut self, _light: u32, _dir: Vec3, _throughput: Rgb, _le: Rgb, _mis_weight: f32) {}
     #[inline(always)]
     fn next_event(&mut self, _e: &NextEvent<'_>) {}
     #[inline(always)]

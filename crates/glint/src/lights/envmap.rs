@@ -73,6 +73,25 @@ impl EnvMap {
         (a * (1.0 - fy) + b * fy) * self.scale
     }
 
+    /// The texels [`EnvMap::eval`] blends along `dir` (indices into the image's pixels) and
+    /// their weights, before the scale.
+    pub fn taps(&self, dir: Vec3) -> [(usize, f32); 4] {
+        let uv = self.uv_from_dir(dir);
+        let (w, h) = (self.image.width as i64, self.image.height as i64);
+        let x = uv[0] * w as f32 - 0.5;
+        let y = uv[1] * (h - 1).max(1) as f32;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let at = |xi: i64, yi: i64| yi.clamp(0, h - 1) as usize * self.image.width + xi.rem_euclid(w) as usize;
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        [
+            (at(x0, y0), (1.0 - fx) * (1.0 - fy)),
+            (at(x0 + 1, y0), fx * (1.0 - fy)),
+            (at(x0, y0 + 1), (1.0 - fx) * fy),
+            (at(x0 + 1, y0 + 1), fx * fy),
+        ]
+    }
+
     pub fn pdf(&self, dir: Vec3) -> f32 {
         let uv = self.uv_from_dir(dir);
         let (w, h) = (self.image.width, self.image.height);

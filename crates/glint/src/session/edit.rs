@@ -27,18 +27,20 @@
 use super::Session;
 use crate::assemble::{patch_appearance, BuildCounters};
 use crate::describe::slots::Slot;
-use crate::describe::{Emission, FovAxis, LightKind, MaterialRef, Matrix4, Projection, TextureDesc};
+use crate::describe::{Emission, FovAxis, LightKind, MaterialRef, Matrix4, Projection, Texels, TextureDesc};
 use crate::error::Error;
 use crate::materials::SceneDesc;
 use crate::math::Rgb;
 use std::sync::Arc;
 
 /// A parameter's value.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum ParamValue {
     Float(f32),
     Color(Rgb),
     Matrix(Matrix4),
+    /// An image's texels (a bitmap texture's, an environment map's).
+    Image(Texels),
 }
 
 impl ParamValue {
@@ -47,8 +49,26 @@ impl ParamValue {
             ParamValue::Float(_) => "a number",
             ParamValue::Color(_) => "a colour (3 numbers)",
             ParamValue::Matrix(_) => "a 4x4 matrix",
+            ParamValue::Image(_) => "an image (height, width, 3)",
         }
     }
+}
+
+/// Texels an edit may set: at least one, as many as the size says, all finite.
+fn check_texels(name: &str, t: &Texels) -> Result<(), Error> {
+    if t.width == 0 || t.height == 0 || t.pixels.len() != t.width * t.height {
+        return Err(Error::new(format!(
+            "{name}: an image of {}x{} needs {} texels, not {}",
+            t.width,
+            t.height,
+            t.width * t.height,
+            t.pixels.len()
+        )));
+    }
+    if let Some(i) = t.pixels.iter().position(|p| !p.is_finite()) {
+        return Err(Error::new(format!("{name}: texel ({}, {}) is not finite", i % t.width, i / t.width)));
+    }
+    Ok(())
 }
 
 /// A named parameter and its value.
@@ -59,12 +79,19 @@ pub struct Param {
 }
 
 impl Slot<'_> {
-    fn get(&self) -> Option<ParamValue> {
+    /// The value; an image's texels are read from its file until an edit sets them (`None`
+    /// where the file cannot be read: the build reports that).
+    pub(crate) fn get(&self) -> Option<ParamValue> {
         Some(match self {
             Slot::Float(v) => ParamValue::Float(**v),
             Slot::Color(v) => ParamValue::Color(**v),
             Slot::Matrix(v) => ParamValue::Matrix(**v),
             Slot::OptionalMatrix(v) => ParamValue::Matrix((**v)?),
+            Slot::Texels { texels: Some(t), .. } => ParamValue::Image(t.clone()),
+            Slot::Texels { file, raw, texels: None, .. } => {
+                let image = crate::io::read_texture_image(file, *raw).ok()?;
+                ParamValue::Image(Texels { width: image.width, height: image.height, pixels: image.pixels })
+            }
         })
     }
 
@@ -76,6 +103,10 @@ impl Slot<'_> {
             (Slot::Color(v), ParamValue::Color(x)) => *v = x,
             (Slot::Matrix(v), ParamValue::Matrix(x)) => *v = x,
             (Slot::OptionalMatrix(v), ParamValue::Matrix(x)) => *v = Some(x),
+            (Slot::Texels { texels, .. }, ParamValue::Image(t)) => {
+                check_texels(name, &t)?;
+                *texels = Some(t);
+            }
             (slot, value) => {
                 let expected = slot.get().map_or("a 4x4 matrix", |v| v.kind());
                 return Err(Error::new(format!("{name} is {expected}, not {}", value.kind())));
@@ -108,7 +139,10 @@ fn light_slots(l: &mut LightKind) -> Vec<(&'static str, Slot<'_>)> {
         }
         LightKind::Directional { irradiance, .. } => vec![("irradiance", Slot::Color(irradiance))],
         LightKind::Constant { radiance } => vec![("radiance", Slot::Color(radiance))],
-        LightKind::EnvMap { scale, .. } => vec![("scale", Slot::Float(scale))],
+        LightKind::EnvMap { scale, file, texels, .. } => {
+            let uv = [[1.0, 1.0], [0.0, 0.0]];
+            vec![("scale", Slot::Float(scale)), ("data", Slot::Texels { file, raw: true, texels, uv })]
+        }
         LightKind::TexturedSpot { intensity, .. } => vec![("intensity", Slot::Color(intensity))],
         LightKind::Projector { scale, .. } => vec![("scale", Slot::Float(scale))],
     }
@@ -144,8 +178,9 @@ fn mitsuba_material_names(field: &str) -> &'static [&'static str] {
 impl Field {
     /// Whether `rest`, what follows the object's id and a dot, spells this field.
     fn spelled_by(self, rest: &str) -> bool {
-        // A texture's or spectrum's value is `FIELD.value`; a number is `FIELD`.
-        let rest = rest.strip_suffix(".value").unwrap_or(rest);
+        // A texture's or spectrum's value is `FIELD.value`, a bitmap's texels `FIELD.data`;
+        // a number is `FIELD`.
+        let rest = rest.strip_suffix(".value").or_else(|| rest.strip_suffix(".data")).unwrap_or(rest);
         match self {
             Field::Material(field) => {
                 // Wrappers glint folds into the material (twosided, mask, bump and normal
@@ -347,7 +382,7 @@ fn set_one(desc: &mut SceneDesc, p: &Param) -> Result<(String, Option<ParamValue
         .into_iter()
         .find(|e| e.name == name)
         .ok_or_else(|| Error::new(format!("no parameter called '{name}'")))?;
-    Ok((name, entry.slot.set(&shown, p.value)?, entry.effect))
+    Ok((name, entry.slot.set(&shown, p.value.clone())?, entry.effect))
 }
 
 impl Session {

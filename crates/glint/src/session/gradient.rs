@@ -2,14 +2,19 @@
 //! turned into what the adjoint pass reads.
 
 use super::edit::{resolve_param_name, slots, Owner};
+use super::ParamValue;
 use super::Session;
 use crate::assemble::{build_material, WorldLayout};
 use crate::describe::slots::Slot;
 use crate::describe::PixelFilter;
+use crate::describe::Texels;
 use crate::error::Error;
-use crate::gradient::{render_gradient, GradientJob, LightParam, LightProbe, MaterialProbe, ParamGradient, ParamSet};
+use crate::gradient::{
+    render_gradient, GradientJob, LightParam, LightProbe, MaterialProbe, ParamGradient, ParamSet, TextureProbe,
+};
 use crate::integrators::Integrator;
-use crate::materials::{MaterialDesc, SceneDesc, TextureCache, TexturePoint};
+use crate::lights::Light;
+use crate::materials::{Material, MaterialDesc, SceneDesc, TextureCache, TexturePoint};
 use crate::math::Rgb;
 use crate::world::World;
 use std::sync::atomic::AtomicBool;
@@ -125,6 +130,15 @@ fn add_param(
                     set.add_light_probe(light, LightProbe { index, param: LightParam::Scale { value: *value } });
                     Ok(vec![])
                 }
+                Slot::Texels { .. } => {
+                    let Some(Light::EnvMap(env)) = world.lights.get(light) else {
+                        return Err(not("only an environment map's texels are"));
+                    };
+                    let (w, h) = (env.image.width, env.image.height);
+                    let index = set.new_entries(w * h * 3);
+                    set.add_light_probe(light, LightProbe { index, param: LightParam::Texels { scale: env.scale } });
+                    Ok(vec![h, w, 3])
+                }
                 Slot::Matrix(_) | Slot::OptionalMatrix(_) => Err(not(NOT_GEOMETRY)),
             }
         }
@@ -142,7 +156,56 @@ fn colour_light_param(set: &mut ParamSet, lights: &[usize], value: Rgb) {
     }
 }
 
-/// Material `m`'s `rank`-th parameter: one probe per scalar.
+/// A material parameter's value: its scalars, or an image's texels.
+enum Value {
+    Scalars(Vec<f32>),
+    Texels(Texels, [[f32; 2]; 2]),
+}
+
+/// The `rank`-th parameter of material `d`.
+fn value_of(d: &mut MaterialDesc, rank: usize) -> Option<Value> {
+    match d.model.slots().into_iter().nth(rank).map(|(_, s)| s)? {
+        Slot::Float(v) => Some(Value::Scalars(vec![*v])),
+        Slot::Color(v) => Some(Value::Scalars(v.to_array().to_vec())),
+        slot @ Slot::Texels { .. } => {
+            let Slot::Texels { uv, .. } = &slot else { return None };
+            let uv = *uv;
+            match slot.get()? {
+                ParamValue::Image(t) => Some(Value::Texels(t, uv)),
+                ParamValue::Float(_) | ParamValue::Color(_) | ParamValue::Matrix(_) => None,
+            }
+        }
+        Slot::Matrix(_) | Slot::OptionalMatrix(_) => None,
+    }
+}
+
+/// Material `d` with its `rank`-th parameter moved: scalar `k` (a number's, or a colour's
+/// channel k) to `to`, or an image's channel k by `to` in every texel. `None` where the
+/// material refuses the value.
+fn moved(d: &MaterialDesc, rank: usize, k: usize, to: f32, textures: &mut TextureCache) -> Option<Material> {
+    let mut d = d.clone();
+    match d.model.slots().into_iter().nth(rank).map(|(_, s)| s)? {
+        Slot::Float(x) => *x = to,
+        Slot::Color(x) => {
+            let mut a = x.to_array();
+            a[k] = to;
+            *x = crate::math::rgb(a[0], a[1], a[2]);
+        }
+        Slot::Texels { texels, .. } => {
+            let t = texels.as_mut()?;
+            for p in &mut t.pixels {
+                let mut a = p.to_array();
+                a[k] += to;
+                *p = crate::math::rgb(a[0], a[1], a[2]);
+            }
+        }
+        Slot::Matrix(_) | Slot::OptionalMatrix(_) => return None,
+    }
+    d.model.validate().ok()?;
+    build_material(&d, textures).ok()
+}
+
+/// Material `m`'s `rank`-th parameter: one probe per scalar, or per channel of an image.
 fn material_param(
     set: &mut ParamSet,
     desc: &MaterialDesc,
@@ -158,48 +221,51 @@ fn material_param(
             desc.name
         )));
     }
-    let value = |d: &mut MaterialDesc| -> Vec<f32> {
-        match d.model.slots().into_iter().nth(rank).map(|(_, s)| s) {
-            Some(Slot::Float(v)) => vec![*v],
-            Some(Slot::Color(v)) => v.to_array().to_vec(),
-            Some(Slot::Matrix(_)) | Some(Slot::OptionalMatrix(_)) | None => vec![],
-        }
-    };
-    let values = value(&mut desc.clone());
-    if values.is_empty() {
+    let mut desc = desc.clone();
+    let Some(value) = value_of(&mut desc, rank) else {
         return Err(Error::new(format!("'{name}' is not differentiable: {NOT_GEOMETRY}")));
-    }
-    for (k, &v) in values.iter().enumerate() {
+    };
+    // A side the material refuses (a roughness at zero, say) is the value itself: the
+    // difference is then one-sided.
+    let mut probe = |index: usize, k: usize, v: f32, from: f32, d: &MaterialDesc| -> Result<MaterialProbe, Error> {
         let step = (v.abs() * RELATIVE_STEP).max(MIN_STEP);
-        // A side the material refuses (a roughness at zero, say) is the value itself: the
-        // difference is then one-sided.
-        let mut moved = |to: f32| -> Option<(f32, crate::materials::Material)> {
-            let mut d = desc.clone();
-            match d.model.slots().into_iter().nth(rank).map(|(_, s)| s) {
-                Some(Slot::Float(x)) => *x = to,
-                Some(Slot::Color(x)) => {
-                    let mut a = x.to_array();
-                    a[k] = to;
-                    *x = crate::math::rgb(a[0], a[1], a[2]);
-                }
-                Some(Slot::Matrix(_)) | Some(Slot::OptionalMatrix(_)) | None => return None,
-            }
-            d.model.validate().ok()?;
-            Some((to, build_material(&d, &mut textures).ok()?))
+        let (lo, minus) = match moved(d, rank, k, from - step, &mut textures) {
+            Some(x) => (from - step, x),
+            None => (from, built.clone()),
         };
-        let (lo, minus) = match moved(v - step) {
-            Some(x) => x,
-            None => (v, built.clone()),
-        };
-        let (hi, plus) = match moved(v + step) {
-            Some(x) => x,
-            None => (v, built.clone()),
+        let (hi, plus) = match moved(d, rank, k, from + step, &mut textures) {
+            Some(x) => (from + step, x),
+            None => (from, built.clone()),
         };
         if !(hi > lo) {
             return Err(Error::new(format!("'{name}': the material accepts no value near {v} but {v}")));
         }
-        let index = set.new_entry();
-        set.add_material_probe(m, MaterialProbe { index, minus, plus, inv_step: 1.0 / (hi - lo) });
+        Ok(MaterialProbe { index, minus, plus, inv_step: 1.0 / (hi - lo) })
+    };
+    match value {
+        Value::Scalars(values) => {
+            for (k, &v) in values.iter().enumerate() {
+                let index = set.new_entry();
+                let p = probe(index, k, v, v, &desc)?;
+                set.add_material_probe(m, p);
+            }
+            Ok(if values.len() == 1 { vec![] } else { vec![3] })
+        }
+        Value::Texels(t, uv) => {
+            // The probes hold the texels (read from the file once), moved by a step.
+            let mut with_texels = desc.clone();
+            if let Some(Slot::Texels { texels, .. }) = with_texels.model.slots().into_iter().nth(rank).map(|(_, s)| s) {
+                *texels = Some(t.clone());
+            }
+            let base = set.new_entries(t.width * t.height * 3);
+            let mut channels = Vec::with_capacity(3);
+            for k in 0..3 {
+                let typical = t.pixels.iter().map(|p| p.to_array()[k].abs()).sum::<f32>() / t.pixels.len() as f32;
+                channels.push(probe(base, k, typical, 0.0, &with_texels)?);
+            }
+            let channels: [MaterialProbe; 3] = channels.try_into().map_err(|_| Error::new("three channels"))?;
+            set.add_texture_probe(m, TextureProbe { base, width: t.width, height: t.height, uv, channels });
+            Ok(vec![t.height, t.width, 3])
+        }
     }
-    Ok(if values.len() == 1 { vec![] } else { vec![3] })
 }
