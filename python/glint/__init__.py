@@ -392,7 +392,21 @@ class SceneParameters(MutableMapping):
                 self._kinds[name] = "float"
                 self._values[name] = float(v)
 
+    def _name(self, key: str) -> str:
+        """The name ``traverse`` lists for ``key``: that name or an alias of it (Mitsuba's
+        key, such as ``ball.to_world``). KeyError for an unknown or ambiguous one."""
+        if key in self._values:
+            return key
+        if not isinstance(key, str):
+            raise KeyError(key)
+        name = self._scene._param_name(key)
+        if name not in self._values:
+            # An unset camera transform has a name but no value to edit.
+            raise KeyError(f"no parameter called {key!r}")
+        return name
+
     def __getitem__(self, key: str) -> Any:
+        key = self._name(key)
         if key in self._pending:
             v = self._pending[key]
         else:
@@ -400,8 +414,7 @@ class SceneParameters(MutableMapping):
         return v.copy() if isinstance(v, np.ndarray) else v
 
     def __setitem__(self, key: str, value: Any) -> None:
-        if key not in self._values:
-            raise KeyError(f"no parameter called {key!r}")
+        key = self._name(key)
         kind = self._kinds[key]
         if kind == "float":
             if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
@@ -453,8 +466,14 @@ def traverse(scene: Scene) -> SceneParameters:
 
     Names: ``materials.NAME.reflectance`` (and ``kd``, ``diffuse`` when constant, ``ks``,
     ``exponent``, ``eta``, ``k``, ``specular``, ``reflect``, ``transmit``, ``alpha``),
-    ``lights.I.radiance`` / ``intensity`` / ``irradiance`` / ``scale``,
-    ``shapes.I.emission``, ``shapes.I.to_world``, ``camera.fov``, ``camera.to_world``.
+    ``lights.ID.radiance`` / ``intensity`` / ``irradiance`` / ``scale``,
+    ``shapes.ID.emission``, ``shapes.ID.to_world``, ``camera.fov``, ``camera.to_world``.
+    A shape or light is named by its id in the file (Mitsuba's ``id``) where no other
+    shares it, else by its index (``shapes.0.to_world``).
+    Mitsuba's keys are accepted as aliases when reading and assigning:
+    ``ball.to_world``, ``ball.emitter.radiance.value``, ``paint.reflectance.value``,
+    ``plastic.diffuse_reflectance.value``, ``sun.intensity.value``,
+    ``PerspectiveCamera.to_world``, ``PerspectiveCamera.x_fov`` and so on.
     Assign, then call ``update()``.
     """
     return SceneParameters(scene)

@@ -7,7 +7,7 @@ use glint::materials::SceneDesc;
 use glint::math::{Rgb, Vec3};
 use glint::session::{Param, ParamValue, Session};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use std::collections::HashMap;
@@ -203,6 +203,12 @@ impl Scene {
             .map(|p| Ok((p.name.clone(), value_to_py(py, &p.value)?)))
             .collect::<PyResult<Vec<_>>>()?;
         PyList::new(py, items)
+    }
+
+    /// The name `_params` gives a parameter named `name` or by an alias of it (Mitsuba's
+    /// key); KeyError, its message one line, for an unknown or ambiguous one.
+    fn _param_name(&mut self, name: &str) -> PyResult<String> {
+        guard(|| self.session.param_name(name).map_err(|e| PyKeyError::new_err(e.to_string())))
     }
 
     /// Sets parameters given as (name, kind, values) with kind "float" (one value),
