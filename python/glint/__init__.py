@@ -387,7 +387,7 @@ class SceneParameters(MutableMapping):
             if isinstance(v, tuple):
                 kind, data = v
                 self._kinds[name] = kind
-                self._values[name] = np.array(data, dtype=np.float64)
+                self._values[name] = np.array(data, dtype=np.float32 if kind == "image" else np.float64)
             else:
                 self._kinds[name] = "float"
                 self._values[name] = float(v)
@@ -421,6 +421,15 @@ class SceneParameters(MutableMapping):
                 raise TypeError(f"{key} takes a number, not {type(value).__name__}")
             self._pending[key] = float(value)
             return
+        if kind == "image":
+            try:
+                a = np.array(value, dtype=np.float32)
+            except (TypeError, ValueError):
+                raise TypeError(f"{key} takes an image (height, width, 3), not {type(value).__name__}") from None
+            if a.ndim != 3 or a.shape[2] != 3 or a.shape[0] == 0 or a.shape[1] == 0:
+                raise TypeError(f"{key} takes an image of shape (height, width, 3), not {a.shape}")
+            self._pending[key] = a
+            return
         try:
             a = np.array(value, dtype=np.float64)
         except (TypeError, ValueError):
@@ -450,13 +459,16 @@ class SceneParameters(MutableMapping):
         to the scene. Raises SceneError (nothing changed) for values the scene cannot take."""
         for k, v in dict(other, **kwargs).items():
             self[k] = v
-        edits = []
+        edits, images = [], []
         for k, v in self._pending.items():
             kind = self._kinds[k]
+            if kind == "image":
+                images.append((k, np.ascontiguousarray(v, dtype=np.float32)))
+                continue
             values = [v] if kind == "float" else [float(x) for x in np.ravel(v)]
             edits.append((k, kind, values))
-        if edits:
-            self._scene._set_params(edits)
+        if edits or images:
+            self._scene._set_params(edits, images)
         self._pending.clear()
         self._reload()
 

@@ -1,12 +1,12 @@
 //! `Scene`: a loaded scene, its built world and mesh cache (a library session).
 
 use crate::convert::{guard, scene_error};
-use glint::describe::{Geometry, MeshData};
+use glint::describe::{Geometry, MeshData, Texels};
 use glint::formats::{Define, ReadOptions};
 use glint::materials::SceneDesc;
 use glint::math::{Rgb, Vec3};
 use glint::session::{Param, ParamValue, Session};
-use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
@@ -137,6 +137,12 @@ fn value_to_py<'py>(py: Python<'py>, v: &ParamValue) -> PyResult<Bound<'py, PyAn
         ParamValue::Matrix(m) => {
             ("matrix", m.iter().map(|r| r.to_vec()).collect::<Vec<_>>()).into_pyobject(py)?.into_any()
         }
+        ParamValue::Image(t) => {
+            let flat: Vec<f32> = t.pixels.iter().flat_map(|p| p.to_array()).collect();
+            let array = numpy::ndarray::Array3::from_shape_vec((t.height, t.width, 3), flat)
+                .map_err(|e| PyValueError::new_err(e.to_string()))?;
+            ("image", array.into_pyarray(py)).into_pyobject(py)?.into_any()
+        }
     })
 }
 
@@ -212,10 +218,30 @@ impl Scene {
     }
 
     /// Sets parameters given as (name, kind, values) with kind "float" (one value),
-    /// "color" (3) or "matrix" (16, row-major).
-    fn _set_params(&mut self, py: Python<'_>, edits: Vec<(String, String, Vec<f64>)>) -> PyResult<()> {
+    /// "color" (3) or "matrix" (16, row-major), and images as (name, array (H, W, 3)), all
+    /// at once.
+    #[pyo3(signature = (edits, images=Vec::new()))]
+    fn _set_params(
+        &mut self,
+        py: Python<'_>,
+        edits: Vec<(String, String, Vec<f64>)>,
+        images: Vec<(String, PyReadonlyArray3<'_, f32>)>,
+    ) -> PyResult<()> {
         guard(|| {
-            let mut params = Vec::with_capacity(edits.len());
+            let mut params = Vec::with_capacity(edits.len() + images.len());
+            for (name, a) in images {
+                let [height, width, channels] = [a.shape()[0], a.shape()[1], a.shape()[2]];
+                if channels != 3 {
+                    return Err(PyTypeError::new_err(format!("{name}: an image has 3 channels, not {channels}")));
+                }
+                let view = a.as_array();
+                let pixels = view
+                    .outer_iter()
+                    .flat_map(|row| row.outer_iter().map(|p| Rgb { r: p[0], g: p[1], b: p[2] }).collect::<Vec<_>>())
+                    .collect();
+                let texels = Texels { width, height, pixels };
+                params.push(Param { name, value: ParamValue::Image(texels) });
+            }
             for (name, kind, v) in edits {
                 let value = match (kind.as_str(), v.len()) {
                     ("float", 1) => ParamValue::Float(v[0] as f32),
