@@ -122,7 +122,7 @@ fn moved(value: ParamValue, k: usize, by: f32) -> ParamValue {
             a[k] += by;
             ParamValue::Color(rgb(a[0], a[1], a[2]))
         }
-        ParamValue::Matrix(_) => unreachable!("not a test parameter"),
+        ParamValue::Matrix(_) | ParamValue::Image(_) => unreachable!("not a test parameter"),
     }
 }
 
@@ -139,10 +139,10 @@ fn paired(session: &mut Session, name: &str, relative_step: f32, spp: u32, seeds
     let (w, h) = (session.description().film.width as usize, session.description().film.height as usize);
     let g = adjoint(w, h);
     let value = get(session, name);
-    let values = match value {
-        ParamValue::Float(v) => vec![v],
+    let values = match &value {
+        ParamValue::Float(v) => vec![*v],
         ParamValue::Color(c) => c.to_array().to_vec(),
-        ParamValue::Matrix(_) => unreachable!("not a test parameter"),
+        ParamValue::Matrix(_) | ParamValue::Image(_) => unreachable!("not a test parameter"),
     };
     let cancel = AtomicBool::new(false);
     let mut out: Vec<Paired> =
@@ -151,11 +151,11 @@ fn paired(session: &mut Session, name: &str, relative_step: f32, spp: u32, seeds
         let grad = session.render_gradient(&[name.to_string()], &g, spp, seed, &cancel).unwrap().remove(0).values;
         for (k, v) in values.iter().enumerate() {
             let step = (v.abs() * relative_step).max(1e-3);
-            set(session, name, moved(value, k, step));
+            set(session, name, moved(value.clone(), k, step));
             let up = loss(session, &g, spp, seed);
-            set(session, name, moved(value, k, -step));
+            set(session, name, moved(value.clone(), k, -step));
             let down = loss(session, &g, spp, seed);
-            set(session, name, value);
+            set(session, name, value.clone());
             let p = &mut out[k];
             p.gradients.push(grad[k]);
             p.finite_differences.push((up - down) / (2.0 * step as f64));
@@ -280,4 +280,152 @@ fn parameters_without_gradients_are_refused_in_one_line() {
     let short = vec![Rgb::WHITE; 3];
     let e = session.render_gradient(&["materials.floor.reflectance".into()], &short, 1, 0, &cancel).unwrap_err();
     assert!(e.to_string().contains("grad_image"), "{e}");
+}
+
+/// A scene lit by an environment map alone, seen through BSDF sampling alone (so no
+/// sampling decision reads the map's texels or the floor's texture), with a textured floor.
+const TEXEL_SCENE: &str = r#"{
+  "camera": { "position": [0, 1.5, 4], "look_at": [0, 0.3, 0], "up": [0, 1, 0], "fov": 50 },
+  "film": { "width": 12, "height": 10, "filter": "box" },
+  "integrator": { "type": "path", "max_depth": 3, "rr_depth": 100, "strategy": "bsdf" },
+  "sampler": { "spp": 8, "seed": 0, "type": "independent" },
+  "materials": {
+    "floor": { "type": "diffuse", "reflectance": { "texture": "TEXTURE" } },
+    "ball": { "type": "principled", "base_color": [0.6, 0.5, 0.4], "roughness": 0.4 }
+  },
+  "shapes": [
+    { "type": "rectangle", "material": "floor",
+      "transform": [{ "scale": [2, 2, 1] }, { "rotate": { "axis": [1, 0, 0], "angle": -90 } }] },
+    { "type": "sphere", "center": [0.3, 0.5, 0], "radius": 0.5, "material": "ball" }
+  ],
+  "lights": [ { "type": "envmap", "file": "sky.exr", "scale": 1.5 } ]
+}"#;
+
+/// A direction in texel space: ±1 by a hash of the texel and channel.
+fn direction(len: usize) -> Vec<f32> {
+    (0..len as u64).map(|i| if (i.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 40) & 1 == 0 { 1.0 } else { -1.0 }).collect()
+}
+
+/// Texels moved by `by` along `v`.
+fn along(t: &glint::describe::Texels, v: &[f32], by: f32) -> ParamValue {
+    let mut t = t.clone();
+    for (i, p) in t.pixels.iter_mut().enumerate() {
+        *p = rgb(p.r + by * v[3 * i], p.g + by * v[3 * i + 1], p.b + by * v[3 * i + 2]);
+    }
+    ParamValue::Image(t)
+}
+
+/// Per texel gradients (a bitmap texture's, an environment map's) against the finite
+/// difference of renders along a direction that moves every texel: the gradient's inner
+/// product with that direction is the derivative along it.
+#[test]
+fn texel_gradients_agree_with_finite_differences_along_a_direction() {
+    let dir = ScratchDir::new("gradient-texels");
+    let sky: Vec<Rgb> = (0..8 * 4)
+        .map(|i| rgb(0.5 + 0.1 * (i % 8) as f32, 0.4 + 0.2 * (i / 8) as f32, 0.3 + 0.05 * (i % 5) as f32))
+        .collect();
+    glint::io::write_image(&glint::io::Image { width: 8, height: 4, pixels: sky }, &dir.join("sky.exr")).unwrap();
+    let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/scenes/gradients/texture.exr");
+    let scene = TEXEL_SCENE.replace("TEXTURE", &texture.to_string_lossy());
+    std::fs::write(dir.join("scene.json"), scene).unwrap();
+    let mut session = Session::open(&dir.join("scene.json"), &ReadOptions::default()).unwrap();
+    let g = adjoint(12, 10);
+    let cancel = AtomicBool::new(false);
+    let params = ["materials.floor.reflectance", "lights.0.data"];
+    let z = z_critical(FALSE_ALARM, params.len());
+    let mut failures = Vec::new();
+    for name in params {
+        let ParamValue::Image(texels) = get(&mut session, name) else { panic!("{name} is not an image") };
+        let v = direction(texels.pixels.len() * 3);
+        let step = 0.02;
+        let (mut diffs, mut fds, mut rounding) = (Vec::new(), Vec::new(), Vec::new());
+        for seed in 0..8 {
+            let grad = session.render_gradient(&[name.to_string()], &g, 8, seed, &cancel).unwrap().remove(0);
+            assert_eq!(grad.shape, vec![texels.height, texels.width, 3], "{name}");
+            let projected: f64 = grad.values.iter().zip(&v).map(|(a, b)| a * *b as f64).sum();
+            set(&mut session, name, along(&texels, &v, step));
+            let up = loss(&mut session, &g, 8, seed);
+            set(&mut session, name, along(&texels, &v, -step));
+            let down = loss(&mut session, &g, 8, seed);
+            set(&mut session, name, ParamValue::Image(texels.clone()));
+            let fd = (up - down) / (2.0 * step as f64);
+            diffs.push(projected - fd);
+            fds.push(fd);
+            rounding.push(2f64.powi(-24) * (up.abs() + down.abs()) / (2.0 * step as f64));
+        }
+        let (d, se) = mean_se(&diffs);
+        let (fd, _) = mean_se(&fds);
+        let (r, _) = mean_se(&rounding);
+        let allowed = z * se + r;
+        println!("{name}: along the direction, gradient - finite difference {d:.2e} (allowed {allowed:.2e}), finite difference {fd:.4}");
+        if d.abs() > allowed {
+            failures.push(format!("{name}: gradient and finite difference differ by {d} (allowed {allowed:.2e})"));
+        }
+        if allowed > 0.2 * fd.abs() {
+            failures.push(format!("{name}: cannot see a 20% error (allowed {allowed:.2e}, finite difference {fd})"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// A reflectance of zero reflects nothing, yet raising it brightens the image: its gradient
+/// is not zero, and agrees with a one-sided finite difference.
+#[test]
+fn a_black_reflectance_has_a_gradient() {
+    let dir = ScratchDir::new("gradient-black");
+    let mut session = open(&dir, Setup::DirectByLightSampling);
+    let name = "materials.floor.reflectance";
+    set(&mut session, name, ParamValue::Color(Rgb::BLACK));
+    let g = adjoint(14, 12);
+    let cancel = AtomicBool::new(false);
+    let grad = session.render_gradient(&[name.to_string()], &g, 8, 3, &cancel).unwrap().remove(0).values;
+    let base = loss(&mut session, &g, 8, 3);
+    set(&mut session, name, ParamValue::Color(rgb(0.01, 0.0, 0.0)));
+    let up = loss(&mut session, &g, 8, 3);
+    let fd = (up - base) / 0.01;
+    // Direct light only: the image is linear in the floor's reflectance, so the one-sided
+    // difference is exact up to rounding.
+    assert!(
+        grad[0] > 0.0 && (grad[0] - fd).abs() <= 1e-4 * fd.abs() + 2f64.powi(-24) * up.abs() / 0.01,
+        "{grad:?} against {fd}"
+    );
+}
+
+/// The environment map's texel gradient through next-event estimation too: under MIS the
+/// map's importance sampling reads the texels, so no finite difference with one seed is
+/// smooth; but the image's expectation, and so the gradient's, does not depend on the
+/// strategy, so the MIS gradient's mean (projected on a direction) must agree with that of
+/// BSDF sampling alone, checked above against finite differences.
+#[test]
+fn environment_map_gradients_agree_across_strategies() {
+    let dir = ScratchDir::new("gradient-env-strategies");
+    let sky: Vec<Rgb> =
+        (0..8 * 4).map(|i| rgb(0.2 + 0.3 * (i % 3) as f32, 0.5, 0.1 + 0.9 * ((i / 8) % 2) as f32)).collect();
+    glint::io::write_image(&glint::io::Image { width: 8, height: 4, pixels: sky }, &dir.join("sky.exr")).unwrap();
+    let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/scenes/gradients/texture.exr");
+    std::fs::write(dir.join("scene.json"), TEXEL_SCENE.replace("TEXTURE", &texture.to_string_lossy())).unwrap();
+    let mut session = Session::open(&dir.join("scene.json"), &ReadOptions::default()).unwrap();
+    let g = adjoint(12, 10);
+    let cancel = AtomicBool::new(false);
+    let name = "lights.0.data";
+    let v = direction(8 * 4 * 3);
+    let projected = |session: &mut Session, strategy: glint::integrators::Strategy, seeds: std::ops::Range<u64>| {
+        if let glint::integrators::Integrator::Path(p) = &mut session.edit().integrator {
+            p.strategy = strategy;
+        }
+        let values: Vec<f64> = seeds
+            .map(|seed| {
+                let grad = session.render_gradient(&[name.to_string()], &g, 16, seed, &cancel).unwrap().remove(0);
+                grad.values.iter().zip(&v).map(|(a, b)| a * *b as f64).sum()
+            })
+            .collect();
+        mean_se(&values)
+    };
+    let (bsdf, se_bsdf) = projected(&mut session, glint::integrators::Strategy::Bsdf, 0..24);
+    let (mis, se_mis) = projected(&mut session, glint::integrators::Strategy::Mis, 100..124);
+    let se = (se_bsdf * se_bsdf + se_mis * se_mis).sqrt();
+    let z = z_critical(FALSE_ALARM, 1);
+    println!("along the direction: BSDF sampling {bsdf:.4} ± {se_bsdf:.4}, MIS {mis:.4} ± {se_mis:.4}");
+    assert!((bsdf - mis).abs() <= z * se, "BSDF sampling {bsdf} ± {se_bsdf}, MIS {mis} ± {se_mis}");
+    assert!(z * se < 0.2 * bsdf.abs(), "cannot see a 20% error: {bsdf} ± {se}");
 }

@@ -105,6 +105,9 @@ impl<'a> Adjoint<'a> {
 }
 
 impl PathObserver for Adjoint<'_> {
+    // A black BSDF value can still have a derivative.
+    const SEES_BLACK_BSDF: bool = true;
+
     fn emission(&mut self, light: u32, dir: Vec3, throughput: Rgb, le: Rgb, mis_weight: f32) {
         self.gathered += throughput * le * mis_weight;
         self.through_emission(light, dir, le, throughput * mis_weight);

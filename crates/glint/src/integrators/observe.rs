@@ -37,6 +37,10 @@ pub(crate) struct Scattering<'a> {
 }
 
 pub(crate) trait PathObserver {
+    /// Whether [`PathObserver::next_event`] also sees lights whose BSDF value is black
+    /// (which rendering skips: they add nothing).
+    const SEES_BLACK_BSDF: bool;
+
     /// Light `light` added `throughput * le * mis_weight` to the path's radiance (an area
     /// light hit, or an environment light seen by an escaped ray), along direction `dir`.
     fn emission(&mut self, light: u32, dir: Vec3, throughput: Rgb, le: Rgb, mis_weight: f32);
@@ -49,6 +53,8 @@ pub(crate) trait PathObserver {
 pub(crate) struct Unobserved;
 
 impl PathObserver for Unobserved {
+    const SEES_BLACK_BSDF: bool = false;
+
     #[inline(always)]
     fn emission(&mut self, _light: u32, _dir: Vec3, _throughput: Rgb, _le: Rgb, _mis_weight: f32) {}
     #[inline(always)]

@@ -175,8 +175,9 @@ impl PathState {
             if let Some((ls, pick_pmf, light)) = sample_light(scene, si.p, rng) {
                 let wi = frame.to_local(ls.wi);
                 let f = bsdf.eval(wo, wi);
-                if !f.is_black() {
-                    c.shadow_rays += 1;
+                // A black BSDF value adds nothing, but its derivative may not be zero (a
+                // reflectance of 0 that an optimiser is to raise): observers that ask see it.
+                if !f.is_black() || O::SEES_BLACK_BSDF {
                     let light_pdf = pick_pmf * ls.pdf;
                     let mis_weight = if ls.delta || s.strategy == Strategy::Light {
                         1.0
@@ -197,12 +198,15 @@ impl PathState {
                         mis_weight,
                         light_pdf,
                     });
-                    self.shadow = Some(ShadowQuery {
-                        ray: shadow_ray(&si, ls.wi, ls.dist),
-                        contribution: self.throughput * f * ls.radiance,
-                        mis_weight,
-                        light_pdf,
-                    });
+                    if !f.is_black() {
+                        c.shadow_rays += 1;
+                        self.shadow = Some(ShadowQuery {
+                            ray: shadow_ray(si, ls.wi, ls.dist),
+                            contribution: self.throughput * f * ls.radiance,
+                            mis_weight,
+                            light_pdf,
+                        });
+                    }
                 }
             }
         }
