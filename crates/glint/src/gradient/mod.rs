@@ -47,6 +47,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// sample can be far below a pixel value's resolution.
 const GRADIENT_EXTRA_BITS: i32 = 24;
 
+/// Camera samples between two looks at the cancel flag.
+const CANCEL_CHECK_SAMPLES: u32 = 64;
+
 /// One parameter's gradient.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamGradient {
@@ -68,7 +71,7 @@ pub struct GradientJob<'a> {
 }
 
 /// The gradient of `sum(grad_image * image)` with respect to each of the set's scalar
-/// parameters (see the module doc). `Err` when cancelled (checked between rows).
+/// parameters (see the module doc). `Err` when cancelled (checked every few samples).
 pub fn render_gradient(job: &GradientJob<'_>, cancel: &AtomicBool) -> Result<Vec<f64>, Error> {
     let (w, h) = (job.world.camera.width, job.world.camera.height);
     if job.grad_image.len() != w as usize * h as usize {
@@ -83,15 +86,16 @@ pub fn render_gradient(job: &GradientJob<'_>, cancel: &AtomicBool) -> Result<Vec
         .try_fold(
             || vec![0i128; n],
             |mut sums, y| {
-                if cancel.load(Ordering::Relaxed) {
-                    return Err(Error::new("cancelled"));
-                }
                 for x in 0..w {
                     let adjoint = job.grad_image[(y * w + x) as usize] / job.spp as f32;
                     if adjoint.is_black() {
                         continue;
                     }
                     for s in 0..job.spp {
+                        // Checked often enough that a pixel of many samples stops soon.
+                        if s % CANCEL_CHECK_SAMPLES == 0 && cancel.load(Ordering::Relaxed) {
+                            return Err(Error::new("cancelled"));
+                        }
                         sample_gradient(job, x, y, s, adjoint, &mut sums);
                     }
                 }

@@ -15,6 +15,9 @@
 //! seen from below, such a part is evaluated with both directions mirrored to its front.
 //! The parts live behind a `Box` (a blend is built per hit, the one material kind that
 //! allocates); every other BSDF stays inline.
+//!
+//! # Differentiable
+//! `weight` and both parts' parameters, as `traverse` lists them. See `docs/differentiable.md`.
 
 use super::{Bsdf, MaterialKind, ScalarTexture, Shade, TextureCache, TexturePoint};
 use super::{Describe, MaterialModel};

@@ -43,6 +43,11 @@
 //! pbrt-v4 separates them the same way); `sample` hashes `wo` and its own random numbers.
 //! Every render stays bit-reproducible and independent of the thread count, and averaging
 //! over `seed` averages independent estimates (the tests do).
+//!
+//! # Differentiable
+//! Every parameter `traverse` lists for it. Its BSDF value is a random-walk estimate whose
+//! random numbers the directions fix, so the gradient's symmetric difference uses common
+//! random numbers. See `docs/differentiable.md`.
 
 use super::{Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{eval_rough_dielectric, pdf_rough_dielectric, sample_rough_dielectric};

@@ -5,6 +5,11 @@
 //! # The BSDF
 //! Metals (Mitsuba's `conductor` and `roughconductor`): Fresnel reflection with a complex
 //! index of refraction per channel, off a perfect mirror or a microfacet surface.
+//!
+//! # Differentiable
+//! A rough conductor's parameters: `alpha` (and `alpha_v`), `eta`, `k`, `specular`. A smooth
+//! conductor reflects through a delta lobe, which has no value to differentiate: asking for
+//! its parameters is an error. See `docs/differentiable.md`.
 
 use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_conductor, reflect_local, BsdfSample, Microfacet, Scatter};

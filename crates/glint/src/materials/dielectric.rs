@@ -6,6 +6,11 @@
 //! # The BSDF
 //! Glass (Mitsuba's `dielectric`, `roughdielectric` and `thindielectric`): `eta` is
 //! n_inside / n_outside; `reflect` and `transmit` tint the two directions.
+//!
+//! # Differentiable
+//! A rough dielectric's parameters (`alpha`, `eta`, `reflect`, `transmit`), through its BSDF's
+//! value (directions are detached). Smooth and thin dielectrics scatter through delta lobes
+//! only: asking for their parameters is an error. See `docs/differentiable.md`.
 
 use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{eval_rough_dielectric, pdf_rough_dielectric, sample_rough_dielectric};

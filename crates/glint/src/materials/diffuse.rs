@@ -2,6 +2,9 @@
 //!
 //! # The BSDF
 //! Lambertian reflection (Mitsuba's `diffuse`).
+//!
+//! # Differentiable
+//! `reflectance`, a constant colour or a bitmap texture per texel. See `docs/differentiable.md`.
 
 use super::{Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{BsdfSample, Scatter};

@@ -14,6 +14,9 @@
 //! 2011, with Mitsuba's scale tilt), an attenuation A_p (Fresnel and absorption along the
 //! path through the fibre) and an azimuthal lobe N_p (a trimmed logistic around the
 //! specular Δφ). At zero absorption the A_p sum to 1 and each M_p N_p to 1: energy is kept.
+//!
+//! # Differentiable
+//! Every number and colour `traverse` lists for it. See `docs/differentiable.md`.
 
 use super::{Bsdf, Describe, MaterialKind, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, BsdfSample, Scatter};

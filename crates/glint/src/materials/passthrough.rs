@@ -6,6 +6,9 @@
 //! The two BSDFs without parameters: [`Black`] absorbs everything (emitters without a
 //! material), [`Null`] passes light straight through unchanged (Mitsuba's `null`: the
 //! boundary of a medium).
+//!
+//! # Differentiable
+//! Nothing: `black` and `null` have no parameters. See `docs/differentiable.md`.
 
 use super::{Bsdf, Describe, MaterialKind, Shade, TextureCache, TexturePoint};
 use crate::bsdf::{BsdfSample, Scatter};

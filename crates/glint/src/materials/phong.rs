@@ -4,6 +4,9 @@
 //! # The BSDF
 //! Diffuse + normalised Phong lobe (Lafortune and Willems 1994): energy-conserving when
 //! kd + ks <= 1, so the same material works in the Whitted and the path tracer.
+//!
+//! # Differentiable
+//! `kd` and `ks` (constant colours, or bitmap textures per texel) and `exponent`. See `docs/differentiable.md`.
 
 use super::{Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{reflect_local, BsdfSample, Scatter};

@@ -12,6 +12,12 @@
 //! the rough interface's own transmittance, tabulated over the cosine at construction, and
 //! its internal reflectance (Mitsuba's `roughplastic` model), both integrated here with the
 //! rough dielectric BSDF.
+//!
+//! # Differentiable
+//! `diffuse` (a constant or a bitmap texture per texel), `specular`, `eta` and `alpha`,
+//! through the value of the non-delta lobes (a smooth plastic's specular lobe is a delta).
+//! The rough coating's tables are a fixed quadrature, smooth in `alpha` only at about the
+//! gradient's step (`docs/differentiable.md`). See `docs/differentiable.md`.
 
 use super::{constant_microfacet, Bsdf, Describe, MaterialKind, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, reflect_local, BsdfSample, Microfacet, Scatter};

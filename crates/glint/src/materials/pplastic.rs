@@ -8,6 +8,10 @@
 //! (1 - F(cos θo)) ρ/π (1 - F(cos θi)), with no internal-scattering series and no 1/η²
 //! (unlike `roughplastic`). The lobes are chosen with a fixed probability, the specular
 //! reflectance's share of the two albedos.
+//!
+//! # Differentiable
+//! `diffuse` (a constant or a bitmap texture per texel), `specular`, `eta`, `alpha` and
+//! `alpha_v`. See `docs/differentiable.md`.
 
 use super::{roughness_map, Bsdf, Describe, MaterialKind, RoughnessMap, Shade, Texture, TextureCache, TexturePoint};
 use crate::bsdf::{fresnel_dielectric, BsdfSample, Microfacet, Scatter};

@@ -1,6 +1,10 @@
 //! The wrappers around a material that change the surface rather than how it scatters:
 //! `normalmap` and `bumpmap` (a tilted shading frame) and `mask` (opacity). Each holds the
 //! material it wraps; its own BSDF is black, the nested one scattering.
+//!
+//! # Differentiable
+//! The nested material's parameters; the normal map, the height map and the opacity are
+//! not differentiable. See `docs/differentiable.md`.
 
 use super::{Black, Bsdf};
 use super::{Describe, Material, MaterialKind, MaterialModel, Shade, Texture, TextureCache, TexturePoint};

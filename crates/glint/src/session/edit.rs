@@ -608,7 +608,7 @@ mod tests {
         m[0][3] = 2.0;
         session.set_params(&[Param { name: "ball.to_world".into(), value: ParamValue::Matrix(m) }]).unwrap();
         let params = session.params();
-        let get = |n: &str| params.iter().find(|p| p.name == n).map(|p| p.value);
+        let get = |n: &str| params.iter().find(|p| p.name == n).map(|p| p.value.clone());
         assert_eq!(get("materials.paint.reflectance"), Some(ParamValue::Color(red)));
         assert_eq!(get("shapes.ball.to_world"), Some(ParamValue::Matrix(m)));
         // A wrong value names the alias and the parameter, and changes nothing.

@@ -1,5 +1,9 @@
 //! The textured glTF material: what a hit evaluates into a [`GltfPbr`], and glTF textures
 //! (an image with its sampler, texture coordinate set and `KHR_texture_transform`).
+//!
+//! # Differentiable
+//! Its factors, as `traverse` lists them; its own textures (glTF images) are not
+//! differentiable per texel. See `docs/differentiable.md`.
 
 mod bsdf;
 mod desc;

@@ -1,5 +1,9 @@
 //! `principled`: Mitsuba's principled (Disney) BSDF with textured parameters; what a hit
 //! evaluates into a [`Principled`] (parameters: `describe::PrincipledDesc`).
+//!
+//! # Differentiable
+//! Every parameter `traverse` lists for it (`base_color`, `roughness`, `metallic`, `specular`,
+//! `sheen`, `clearcoat`, ...), constants or bitmap textures per texel. See `docs/differentiable.md`.
 
 mod bsdf;
 mod desc;

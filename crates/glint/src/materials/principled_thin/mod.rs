@@ -36,6 +36,9 @@
 //! As in Mitsuba, the specular reflection exists only through `spec_trans` (a thin sheet
 //! with `spec_trans` 0 is purely diffuse), and a transmitted sample keeps η = 1 (no radiance
 //! scaling: both sides are the same medium).
+//!
+//! # Differentiable
+//! Every parameter `traverse` lists for it, constants or bitmap textures per texel. See `docs/differentiable.md`.
 
 mod bsdf;
 
