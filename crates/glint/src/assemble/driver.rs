@@ -418,13 +418,19 @@ pub(crate) fn patch_appearance(world: &mut World, desc: &SceneDesc, layout: &Wor
         world.materials[i] = m;
     }
     world.update_material_flags();
+    // Made again from the new radiance: a textured one's importance sampling follows it.
     for (light, e) in emission {
-        match &mut world.lights[light] {
-            Light::Mesh { radiance, two_sided, .. } => {
-                *radiance = e.radiance;
-                *two_sided = e.two_sided;
+        let l = &mut world.lights[light];
+        match l {
+            Light::Mesh { instance, emitter, .. } => {
+                *l = Light::mesh(*instance, emitter.clone(), e.radiance, e.two_sided)
             }
-            Light::Sphere { radiance, .. } | Light::Cylinder { radiance, .. } => *radiance = e.radiance,
+            Light::Sphere { instance, sphere, inward, .. } => {
+                *l = Light::sphere(*instance, *sphere, e.radiance, *inward)
+            }
+            Light::Cylinder { instance, cylinder, inward, .. } => {
+                *l = Light::cylinder(*instance, *cylinder, e.radiance, *inward)
+            }
             Light::Point { .. }
             | Light::Spot { .. }
             | Light::Directional { .. }

@@ -1,12 +1,12 @@
 //! The adjoint pass's view of a replayed path: at each event, the adjoint radiance times
 //! the event's derivative with respect to each parameter it depends on, added to the sums.
 
-use super::params::{LightParam, LightProbe};
+use super::params::{bitmap_taps, LightParam, LightProbe};
 use super::{fixed, ParamSet};
 use crate::integrators::{shadow_ray, transmittance, Counters, NextEvent, PathObserver, Scattering};
 use crate::lights::Light;
 use crate::materials::{ShadedBsdf, TexturePoint};
-use crate::math::{rgb, Rgb, Vec3};
+use crate::math::{rgb, Ray, Rgb, Vec3};
 use crate::world::{SurfaceInteraction, World};
 
 pub(super) struct Adjoint<'a> {
@@ -77,11 +77,30 @@ impl<'a> Adjoint<'a> {
     }
 
     /// Differentiates a contribution `weight * le` through light `light`'s emission `le`
-    /// along `dir`.
-    fn through_emission(&mut self, light: u32, dir: Vec3, le: Rgb, weight: Rgb) {
+    /// along `dir`; `at` finds the point of an area light that emits it.
+    fn through_emission(
+        &mut self,
+        light: u32,
+        dir: Vec3,
+        at: impl FnOnce() -> Option<SurfaceInteraction>,
+        le: Rgb,
+        weight: Rgb,
+    ) {
+        let mut at = Some(at);
         for probe in self.params.light_probes(light) {
             match probe.param {
-                LightParam::Texels { scale } => self.through_texels(probe, light, dir, weight * scale),
+                LightParam::Texels { scale } => self.through_map_texels(probe, light, dir, weight * scale),
+                LightParam::AreaTexels { width, height, uv } => {
+                    // A light has at most one textured radiance: found once.
+                    let Some(si) = at.take().and_then(|f| f()) else { continue };
+                    let Some(l) = self.world.lights.get(light as usize) else { continue };
+                    if l.emitting_texture(si.ng, dir).is_none() {
+                        continue;
+                    }
+                    let p = self.world.texture_point(&si);
+                    let taps = bitmap_taps(probe.index, width, height, uv, p.uv);
+                    self.add_taps(&taps, weight);
+                }
                 LightParam::Channel { .. } | LightParam::Scale { .. } => {
                     let v = self.dot(weight * probe.derivative(le));
                     self.add_scalar(probe.index, v);
@@ -90,17 +109,23 @@ impl<'a> Adjoint<'a> {
         }
     }
 
-    /// An environment map's texels: its emission along `dir` is `scale` times the blend of
-    /// the texels its lookup reads, channel by channel (`weight` includes the scale).
-    fn through_texels(&mut self, probe: &LightProbe, light: u32, dir: Vec3, weight: Rgb) {
-        let Some(Light::EnvMap(env)) = self.world.lights.get(light as usize) else { return };
+    /// Adds the adjoint times `weight`, channel by channel, to the texels `taps` blends.
+    fn add_taps(&mut self, taps: &[(usize, f32); 4], weight: Rgb) {
         let a = self.adjoint;
         let per_channel = [a.r * weight.r, a.g * weight.g, a.b * weight.b];
-        for (texel, w) in env.taps(dir) {
+        for &(index, w) in taps {
             for (c, v) in per_channel.iter().enumerate() {
-                self.add_scalar(probe.index + 3 * texel + c, *v as f64 * w as f64);
+                self.add_scalar(index + c, *v as f64 * w as f64);
             }
         }
+    }
+
+    /// An environment map's texels: its emission along `dir` is `scale` times the blend of
+    /// the texels its lookup reads, channel by channel (`weight` includes the scale).
+    fn through_map_texels(&mut self, probe: &LightProbe, light: u32, dir: Vec3, weight: Rgb) {
+        let Some(Light::EnvMap(env)) = self.world.lights.get(light as usize) else { return };
+        let taps = env.taps(dir).map(|(texel, w)| (probe.index + 3 * texel, w));
+        self.add_taps(&taps, weight);
     }
 }
 
@@ -108,9 +133,9 @@ impl PathObserver for Adjoint<'_> {
     // A black BSDF value can still have a derivative.
     const SEES_BLACK_BSDF: bool = true;
 
-    fn emission(&mut self, light: u32, dir: Vec3, throughput: Rgb, le: Rgb, mis_weight: f32) {
-        self.gathered += throughput * le * mis_weight;
-        self.through_emission(light, dir, le, throughput * mis_weight);
+    fn emission(&mut self, light: u32, dir: Vec3, at: Option<&SurfaceInteraction>, throughput: Rgb, le: Rgb, w: f32) {
+        self.gathered += throughput * le * w;
+        self.through_emission(light, dir, || at.copied(), le, throughput * w);
     }
 
     fn next_event(&mut self, e: &NextEvent<'_>) {
@@ -123,7 +148,16 @@ impl PathObserver for Adjoint<'_> {
         let u = BsdfUse { si: e.si, bsdf: e.bsdf, wo: e.wo, wi: e.wi };
         let (throughput, radiance) = (e.throughput, e.ls.radiance);
         self.through_bsdf(&u, |df| throughput * df * radiance * scale);
-        self.through_emission(e.light, e.ls.wi, e.ls.radiance, e.throughput * e.f * scale);
+        // The light's point, for a textured area light: the hit just past the shadow ray's end.
+        let world = self.world;
+        let at = || {
+            let shadow = shadow_ray(e.si, e.ls.wi, e.ls.dist);
+            let ray = Ray::segment(shadow.origin, shadow.dir, shadow.t_max * 1.01);
+            let hit = world.intersect(&ray)?;
+            let si = world.interaction(&ray, &hit);
+            (si.light == Some(e.light)).then_some(si)
+        };
+        self.through_emission(e.light, e.ls.wi, at, e.ls.radiance, e.throughput * e.f * scale);
     }
 
     fn scattering(&mut self, e: &Scattering<'_>) {

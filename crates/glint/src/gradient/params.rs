@@ -45,25 +45,33 @@ impl TextureProbe {
     /// channels, and their weights.
     #[inline]
     pub fn taps(&self, uv: [f32; 2]) -> [(usize, f32); 4] {
-        let [scale, offset] = self.uv;
-        let uv = [uv[0] * scale[0] + offset[0], uv[1] * scale[1] + offset[1]];
-        let x = uv[0] * self.width as f32 - 0.5;
-        let y = uv[1] * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let at = |x: i64, y: i64| {
-            let texel =
-                y.rem_euclid(self.height as i64) as usize * self.width + x.rem_euclid(self.width as i64) as usize;
-            self.base + 3 * texel
-        };
-        [
-            (at(x0, y0), (1.0 - fx) * (1.0 - fy)),
-            (at(x0 + 1, y0), fx * (1.0 - fy)),
-            (at(x0, y0 + 1), (1.0 - fx) * fy),
-            (at(x0 + 1, y0 + 1), fx * fy),
-        ]
+        bitmap_taps(self.base, self.width, self.height, self.uv, uv)
     }
+}
+
+/// The texels a bitmap of `width` x `height` texels, mapping surface uv by `map` (scale,
+/// offset), blends at `uv`, as gradient entries of their red channels (texel i's is
+/// `base + 3i`), and their weights: the lookup's bilinear filter, wrapping at the edges as
+/// `materials::Bitmap` does.
+#[inline]
+pub fn bitmap_taps(base: usize, width: usize, height: usize, map: [[f32; 2]; 2], uv: [f32; 2]) -> [(usize, f32); 4] {
+    let [scale, offset] = map;
+    let uv = [uv[0] * scale[0] + offset[0], uv[1] * scale[1] + offset[1]];
+    let x = uv[0] * width as f32 - 0.5;
+    let y = uv[1] * height as f32 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let at = |x: i64, y: i64| {
+        let texel = y.rem_euclid(height as i64) as usize * width + x.rem_euclid(width as i64) as usize;
+        base + 3 * texel
+    };
+    [
+        (at(x0, y0), (1.0 - fx) * (1.0 - fy)),
+        (at(x0 + 1, y0), fx * (1.0 - fy)),
+        (at(x0, y0 + 1), (1.0 - fx) * fy),
+        (at(x0 + 1, y0 + 1), fx * fy),
+    ]
 }
 
 /// Which part of a light's emission a parameter is.
@@ -77,6 +85,9 @@ pub enum LightParam {
     /// An environment map's texels (the probe's index is texel 0's red channel; texel i's
     /// channel c is `index + 3i + c`), the map's scale `scale`.
     Texels { scale: f32 },
+    /// An area light's bitmap radiance, per texel (indices as `Texels`'): `width` x `height`
+    /// texels, read at surface uv mapped by `uv` (scale, offset).
+    AreaTexels { width: usize, height: usize, uv: [[f32; 2]; 2] },
 }
 
 /// A light parameter and the gradient entry it feeds.
@@ -95,7 +106,7 @@ impl LightProbe {
     pub fn derivative(&self, le: Rgb) -> Rgb {
         match self.param {
             // Per texel: see the adjoint pass.
-            LightParam::Texels { .. } => Rgb::BLACK,
+            LightParam::Texels { .. } | LightParam::AreaTexels { .. } => Rgb::BLACK,
             LightParam::Scale { value } => {
                 if value != 0.0 {
                     le / value

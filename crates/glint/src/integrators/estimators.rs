@@ -72,7 +72,7 @@ pub(crate) fn add_environment(
         }
         let w = emitter_weight(strategy, prev, || scene.light_pdf(prev.p, li_idx, 0, ray.dir, ray.origin, ray.dir));
         *l += throughput * le * w;
-        observer.emission(li_idx, ray.dir, throughput, le, w);
+        observer.emission(li_idx, ray.dir, None, throughput, le, w);
     }
 }
 
@@ -94,7 +94,7 @@ pub(crate) fn add_emitted(
     if !le.is_black() {
         let w = emitter_weight(strategy, prev, || scene.light_pdf(prev.p, li_idx, si.prim, ray.dir, si.p, si.ng));
         *l += throughput * le * w;
-        observer.emission(li_idx, ray.dir, throughput, le, w);
+        observer.emission(li_idx, ray.dir, Some(si), throughput, le, w);
     }
 }
 

@@ -41,9 +41,18 @@ pub(crate) trait PathObserver {
     /// (which rendering skips: they add nothing).
     const SEES_BLACK_BSDF: bool;
 
-    /// Light `light` added `throughput * le * mis_weight` to the path's radiance (an area
-    /// light hit, or an environment light seen by an escaped ray), along direction `dir`.
-    fn emission(&mut self, light: u32, dir: Vec3, throughput: Rgb, le: Rgb, mis_weight: f32);
+    /// Light `light` added `throughput * le * mis_weight` to the path's radiance along
+    /// direction `dir`: an area light hit at `at`, or an environment light seen by an escaped
+    /// ray (`at` None).
+    fn emission(
+        &mut self,
+        light: u32,
+        dir: Vec3,
+        at: Option<&SurfaceInteraction>,
+        throughput: Rgb,
+        le: Rgb,
+        mis_weight: f32,
+    );
     /// Next-event estimation chose a light; its shadow ray is the observer's to trace.
     fn next_event(&mut self, e: &NextEvent<'_>);
     fn scattering(&mut self, e: &Scattering<'_>);
@@ -56,7 +65,7 @@ impl PathObserver for Unobserved {
     const SEES_BLACK_BSDF: bool = false;
 
     #[inline(always)]
-    fn emission(&mut self, _light: u32, _dir: Vec3, _throughput: Rgb, _le: Rgb, _mis_weight: f32) {}
+    fn emission(&mut self, _: u32, _: Vec3, _: Option<&SurfaceInteraction>, _: Rgb, _: Rgb, _: f32) {}
     #[inline(always)]
     fn next_event(&mut self, _e: &NextEvent<'_>) {}
     #[inline(always)]

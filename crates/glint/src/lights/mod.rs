@@ -550,6 +550,15 @@ impl Light {
     /// Radiance leaving an area light at the point `at` (where its texture is read), of
     /// geometric normal `n`, towards `-wi` (`wi` is the direction the ray travelled).
     pub fn emitted(&self, at: &TexturePoint, n: Vec3, wi: Vec3) -> Rgb {
+        match self.emitting_texture(n, wi) {
+            Some(radiance) => radiance_at(radiance, || *at),
+            None => Rgb::BLACK,
+        }
+    }
+
+    /// The radiance texture of an area light whose surface, of normal `n`, emits along `wi`
+    /// (None for other lights, and for the side that does not emit).
+    pub fn emitting_texture(&self, n: Vec3, wi: Vec3) -> Option<&Texture> {
         let (radiance, two_sided) = match self {
             Light::Mesh { radiance, two_sided, .. } => (radiance, *two_sided),
             Light::Sphere { radiance, .. } | Light::Cylinder { radiance, .. } => (radiance, false),
@@ -558,13 +567,9 @@ impl Light {
             | Light::Directional { .. }
             | Light::Constant { .. }
             | Light::EnvMap(_)
-            | Light::Projected(_) => return Rgb::BLACK,
+            | Light::Projected(_) => return None,
         };
-        if two_sided || n.dot(wi) < 0.0 {
-            radiance_at(radiance, || *at)
-        } else {
-            Rgb::BLACK
-        }
+        (two_sided || n.dot(wi) < 0.0).then_some(radiance)
     }
 
     /// Radiance from an infinite light arriving along a ray that escaped with direction `dir`.

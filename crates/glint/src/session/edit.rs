@@ -26,8 +26,8 @@
 
 use super::Session;
 use crate::assemble::{patch_appearance, BuildCounters};
-use crate::describe::slots::Slot;
-use crate::describe::{Emission, FovAxis, LightKind, MaterialRef, Matrix4, Projection, Texels, TextureDesc};
+use crate::describe::slots::{texture_slot, Slot};
+use crate::describe::{Emission, FovAxis, LightKind, MaterialRef, Matrix4, Projection, Texels};
 use crate::error::Error;
 use crate::materials::SceneDesc;
 use crate::math::Rgb;
@@ -273,16 +273,21 @@ pub(crate) fn slots(desc: &mut SceneDesc) -> Vec<Entry<'_>> {
     }
     for (i, (s, label)) in desc.shapes.iter_mut().zip(shape_labels).enumerate() {
         let ids: Vec<String> = s.id.iter().cloned().collect();
-        // A uniform emitted radiance is editable (a textured one, as a material's texture, not).
-        if let Some(Emission { radiance: TextureDesc::Constant { color }, .. }) = &mut s.emission {
-            out.push(Entry {
-                name: format!("shapes.{label}.emission"),
-                slot: Slot::Color(color),
-                effect: Effect::Appearance,
-                ids: ids.clone(),
-                field: Field::Emission,
-                owner: Owner::Shape(i),
-            });
+        // An emitted radiance is editable as a material's texture is: a constant's colour, a
+        // bitmap's texels.
+        if let Some(Emission { radiance, .. }) = &mut s.emission {
+            let mut emission = Vec::new();
+            texture_slot("emission", radiance, &mut emission);
+            for (_, slot) in emission {
+                out.push(Entry {
+                    name: format!("shapes.{label}.emission"),
+                    slot,
+                    effect: Effect::Appearance,
+                    ids: ids.clone(),
+                    field: Field::Emission,
+                    owner: Owner::Shape(i),
+                });
+            }
         }
         out.push(Entry {
             name: format!("shapes.{label}.to_world"),

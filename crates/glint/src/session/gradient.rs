@@ -110,13 +110,31 @@ fn add_param(
     match owner {
         Owner::Material(m) => material_param(set, &materials[m], m, rank, name),
         Owner::Shape(s) => {
-            let Slot::Color(value) = slot else { return Err(not(NOT_GEOMETRY)) };
             let lights: Vec<usize> = layout.shape_instances[s]
                 .clone()
                 .filter_map(|i| world.instances[i as usize].light.map(|l| l as usize))
                 .collect();
-            colour_light_param(set, &lights, *value);
-            Ok(vec![3])
+            match slot {
+                Slot::Color(value) => {
+                    colour_light_param(set, &lights, *value);
+                    Ok(vec![3])
+                }
+                slot @ Slot::Texels { .. } => {
+                    let Slot::Texels { uv, .. } = &slot else { unreachable!("matched above") };
+                    let uv = *uv;
+                    let Some(ParamValue::Image(t)) = slot.get() else {
+                        return Err(Error::new(format!("'{name}': the emission's image cannot be read")));
+                    };
+                    let (width, height) = (t.width, t.height);
+                    let index = set.new_entries(width * height * 3);
+                    for &light in &lights {
+                        let param = LightParam::AreaTexels { width, height, uv };
+                        set.add_light_probe(light, LightProbe { index, param });
+                    }
+                    Ok(vec![height, width, 3])
+                }
+                Slot::Float(_) | Slot::Matrix(_) | Slot::OptionalMatrix(_) => Err(not(NOT_GEOMETRY)),
+            }
         }
         Owner::Light(l) => {
             let light = layout.shape_lights as usize + l;
