@@ -1,8 +1,10 @@
 """Shared fixtures: the repository's scenes, small versions of them, and the CLI binary."""
 
+import contextlib
 import json
 import os
 import pathlib
+import threading
 
 import pytest
 
@@ -31,3 +33,24 @@ def cli() -> pathlib.Path:
     if not path.exists():
         pytest.fail(f"{path} is missing: build it with cargo build --release -p glint-cli")
     return path
+
+
+@contextlib.contextmanager
+def counting_thread():
+    """A Python thread counting while the block runs: it counts only where the GIL is free.
+    Yields a list whose one item is the count."""
+    counter = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            counter[0] += 1
+            stop.wait(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        yield counter
+    finally:
+        stop.set()
+        t.join()

@@ -8,29 +8,16 @@ import numpy as np
 import pytest
 
 import glint
-from conftest import cornell
+from conftest import cornell, counting_thread
 
 
 def test_other_python_threads_run_while_rendering():
     s = cornell(64)
     glint.render(s, spp=1)  # build first: only the render itself is measured
-    counter = [0]
-    stop = threading.Event()
-
-    def count():
-        while not stop.is_set():
-            counter[0] += 1
-            stop.wait(0.001)
-
-    t = threading.Thread(target=count)
-    t.start()
-    try:
+    with counting_thread() as counter:
         start = counter[0]
         glint.render(s, spp=64)
         during = counter[0] - start
-    finally:
-        stop.set()
-        t.join()
     # Were the GIL held, the counting thread could not run at all during the render.
     assert during > 10
 

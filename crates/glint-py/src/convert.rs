@@ -39,3 +39,15 @@ pub fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
         Err(p) => Err(PyRuntimeError::new_err(format!("glint: internal error: {}", panic_message(p)))),
     }
 }
+
+/// A pool of `threads` worker threads, or `None` for rayon's global pool (all cores).
+pub fn thread_pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {
+    threads
+        .map(|n| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| PyRuntimeError::new_err(format!("threads: {e}")))
+        })
+        .transpose()
+}

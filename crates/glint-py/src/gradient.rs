@@ -2,7 +2,7 @@
 //! (the library's `Session::render_gradient`), computed without the GIL and stopped by
 //! Ctrl-C.
 
-use crate::convert::{panic_message, scene_error};
+use crate::convert::{panic_message, scene_error, thread_pool};
 use crate::render::{DoneSignal, SIGNAL_POLL};
 use crate::scene::Scene;
 use glint::math::rgb;
@@ -48,15 +48,7 @@ pub fn render_gradient<'py>(
     if threads == Some(0) {
         return Err(PyValueError::new_err("threads: must be at least 1"));
     }
-    let pool = match threads {
-        Some(n) => Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| PyRuntimeError::new_err(format!("threads: {e}")))?,
-        ),
-        None => None,
-    };
+    let pool = thread_pool(threads)?;
     let mut s = scene.try_borrow_mut()?;
     let session = &mut s.session;
     let cancel = AtomicBool::new(false);

@@ -1,7 +1,7 @@
 //! `Session`: renders a scene pass by pass into a film, with the GIL released, Ctrl-C,
 //! a time limit, a progress callback and a thread count.
 
-use crate::convert::{guard, panic_message, scene_error};
+use crate::convert::{guard, panic_message, scene_error, thread_pool};
 use crate::images::{image_array, load_denoiser};
 use crate::preview::Preview;
 use crate::scene::Scene;
@@ -405,15 +405,7 @@ impl Session {
             Some(n) => first.saturating_add(n).min(self.film.pass_count()),
             None => self.film.pass_count(),
         };
-        let pool = match self.threads {
-            Some(n) => Some(
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .map_err(|e| PyRuntimeError::new_err(format!("threads: {e}")))?,
-            ),
-            None => None,
-        };
+        let pool = thread_pool(self.threads)?;
         let mut scene = self.scene.try_borrow_mut(py)?;
         // Another session of this scene may have set other overrides.
         scene.session.set_overrides(&self.overrides).map_err(|e| scene_error(py, e))?;

@@ -315,6 +315,39 @@ fn along(t: &glint::describe::Texels, v: &[f32], by: f32) -> ParamValue {
     ParamValue::Image(t)
 }
 
+/// The gradient of image parameter `name` projected on direction `v`, against the finite
+/// difference of renders along `v` with the same seeds: the mean of the paired differences,
+/// its standard error, the mean finite difference, and the mean bound on its rounding.
+fn along_direction(
+    session: &mut Session,
+    name: &str,
+    texels: &glint::describe::Texels,
+    v: &[f32],
+    step: f32,
+    seeds: u64,
+) -> (f64, f64, f64, f64) {
+    let (w, h) = (session.description().film.width as usize, session.description().film.height as usize);
+    let g = adjoint(w, h);
+    let cancel = AtomicBool::new(false);
+    let (mut diffs, mut fds, mut rounding) = (Vec::new(), Vec::new(), Vec::new());
+    for seed in 0..seeds {
+        let grad = session.render_gradient(&[name.to_string()], &g, 8, seed, &cancel).unwrap().remove(0);
+        assert_eq!(grad.shape, vec![texels.height, texels.width, 3], "{name}");
+        let projected: f64 = grad.values.iter().zip(v).map(|(a, b)| a * *b as f64).sum();
+        set(session, name, along(texels, v, step));
+        let up = loss(session, &g, 8, seed);
+        set(session, name, along(texels, v, -step));
+        let down = loss(session, &g, 8, seed);
+        set(session, name, ParamValue::Image(texels.clone()));
+        let fd = (up - down) / (2.0 * step as f64);
+        diffs.push(projected - fd);
+        fds.push(fd);
+        rounding.push(2f64.powi(-24) * (up.abs() + down.abs()) / (2.0 * step as f64));
+    }
+    let ((d, se), (fd, _), (r, _)) = (mean_se(&diffs), mean_se(&fds), mean_se(&rounding));
+    (d, se, fd, r)
+}
+
 /// Per texel gradients (a bitmap texture's, an environment map's) against the finite
 /// difference of renders along a direction that moves every texel: the gradient's inner
 /// product with that direction is the derivative along it.
@@ -329,8 +362,6 @@ fn texel_gradients_agree_with_finite_differences_along_a_direction() {
     let scene = TEXEL_SCENE.replace("TEXTURE", &texture.to_string_lossy());
     std::fs::write(dir.join("scene.json"), scene).unwrap();
     let mut session = Session::open(&dir.join("scene.json"), &ReadOptions::default()).unwrap();
-    let g = adjoint(12, 10);
-    let cancel = AtomicBool::new(false);
     let params = ["materials.floor.reflectance", "lights.0.data"];
     let z = z_critical(FALSE_ALARM, params.len());
     let mut failures = Vec::new();
@@ -338,24 +369,7 @@ fn texel_gradients_agree_with_finite_differences_along_a_direction() {
         let ParamValue::Image(texels) = get(&mut session, name) else { panic!("{name} is not an image") };
         let v = direction(texels.pixels.len() * 3);
         let step = 0.02;
-        let (mut diffs, mut fds, mut rounding) = (Vec::new(), Vec::new(), Vec::new());
-        for seed in 0..8 {
-            let grad = session.render_gradient(&[name.to_string()], &g, 8, seed, &cancel).unwrap().remove(0);
-            assert_eq!(grad.shape, vec![texels.height, texels.width, 3], "{name}");
-            let projected: f64 = grad.values.iter().zip(&v).map(|(a, b)| a * *b as f64).sum();
-            set(&mut session, name, along(&texels, &v, step));
-            let up = loss(&mut session, &g, 8, seed);
-            set(&mut session, name, along(&texels, &v, -step));
-            let down = loss(&mut session, &g, 8, seed);
-            set(&mut session, name, ParamValue::Image(texels.clone()));
-            let fd = (up - down) / (2.0 * step as f64);
-            diffs.push(projected - fd);
-            fds.push(fd);
-            rounding.push(2f64.powi(-24) * (up.abs() + down.abs()) / (2.0 * step as f64));
-        }
-        let (d, se) = mean_se(&diffs);
-        let (fd, _) = mean_se(&fds);
-        let (r, _) = mean_se(&rounding);
+        let (d, se, fd, r) = along_direction(&mut session, name, &texels, &v, step, 8);
         let allowed = z * se + r;
         println!("{name}: along the direction, gradient - finite difference {d:.2e} (allowed {allowed:.2e}), finite difference {fd:.4}");
         if d.abs() > allowed {
@@ -469,26 +483,9 @@ fn textured_area_light_gradients() {
     let mut bsdf = open_with("bsdf");
     let ParamValue::Image(texels) = get(&mut bsdf, name) else { panic!("{name} is not an image") };
     let v = direction(texels.pixels.len() * 3);
-    let project =
-        |grad: &glint::gradient::ParamGradient| -> f64 { grad.values.iter().zip(&v).map(|(a, b)| a * *b as f64).sum() };
     let step = 0.05;
-    let (mut diffs, mut fds, mut rounding) = (Vec::new(), Vec::new(), Vec::new());
-    for seed in 0..16 {
-        let grad = bsdf.render_gradient(&[name.to_string()], &g, 8, seed, &cancel).unwrap().remove(0);
-        assert_eq!(grad.shape, vec![texels.height, texels.width, 3]);
-        let projected = project(&grad);
-        set(&mut bsdf, name, along(&texels, &v, step));
-        let up = loss(&mut bsdf, &g, 8, seed);
-        set(&mut bsdf, name, along(&texels, &v, -step));
-        let down = loss(&mut bsdf, &g, 8, seed);
-        set(&mut bsdf, name, ParamValue::Image(texels.clone()));
-        let fd = (up - down) / (2.0 * step as f64);
-        diffs.push(projected - fd);
-        fds.push(fd);
-        rounding.push(2f64.powi(-24) * (up.abs() + down.abs()) / (2.0 * step as f64));
-    }
     let z = z_critical(FALSE_ALARM, 2);
-    let ((d, se), (fd, _), (r, _)) = (mean_se(&diffs), mean_se(&fds), mean_se(&rounding));
+    let (d, se, fd, r) = along_direction(&mut bsdf, name, &texels, &v, step, 16);
     println!(
         "emission seen: gradient - finite difference {d:.2e} (allowed {:.2e}), finite difference {fd:.4}",
         z * se + r

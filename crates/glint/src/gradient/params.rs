@@ -162,10 +162,7 @@ impl ParamSet {
     }
 
     pub fn add_texture_probe(&mut self, material: usize, probe: TextureProbe) {
-        if self.textures.len() <= material {
-            self.textures.resize_with(material + 1, Vec::new);
-        }
-        self.textures[material].push(probe);
+        push_at(&mut self.textures, material, probe);
     }
 
     #[inline]
@@ -174,17 +171,11 @@ impl ParamSet {
     }
 
     pub fn add_material_probe(&mut self, material: usize, probe: MaterialProbe) {
-        if self.materials.len() <= material {
-            self.materials.resize_with(material + 1, Vec::new);
-        }
-        self.materials[material].push(probe);
+        push_at(&mut self.materials, material, probe);
     }
 
     pub fn add_light_probe(&mut self, light: usize, probe: LightProbe) {
-        if self.lights.len() <= light {
-            self.lights.resize_with(light + 1, Vec::new);
-        }
-        self.lights[light].push(probe);
+        push_at(&mut self.lights, light, probe);
     }
 
     #[inline]
@@ -196,4 +187,12 @@ impl ParamSet {
     pub fn light_probes(&self, light: u32) -> &[LightProbe] {
         self.lights.get(light as usize).map_or(&[], |v| v.as_slice())
     }
+}
+
+/// Adds `item` to list `index` of `lists`, adding empty lists up to it.
+fn push_at<T>(lists: &mut Vec<Vec<T>>, index: usize, item: T) {
+    if lists.len() <= index {
+        lists.resize_with(index + 1, Vec::new);
+    }
+    lists[index].push(item);
 }

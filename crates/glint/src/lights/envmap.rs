@@ -56,34 +56,34 @@ impl EnvMap {
     /// pole (last row, v = 1). Sampling stays piecewise constant over texels; `pdf` describes
     /// that, so the estimate is unbiased whatever the interpolation.
     pub fn eval(&self, dir: Vec3) -> Rgb {
-        let uv = self.uv_from_dir(dir);
-        let (w, h) = (self.image.width as i64, self.image.height as i64);
-        let x = uv[0] * w as f32 - 0.5;
-        let y = uv[1] * (h - 1).max(1) as f32;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let texel = |xi: i64, yi: i64| {
-            let xi = xi.rem_euclid(w) as usize;
-            let yi = yi.clamp(0, h - 1) as usize;
-            self.image.pixels[yi * self.image.width + xi]
-        };
-        let (x0, y0) = (x0 as i64, y0 as i64);
+        let (x0, y0, fx, fy) = self.lookup(dir);
+        let texel = |xi: i64, yi: i64| self.image.pixels[self.texel_index(xi, yi)];
         let a = texel(x0, y0) * (1.0 - fx) + texel(x0 + 1, y0) * fx;
         let b = texel(x0, y0 + 1) * (1.0 - fx) + texel(x0 + 1, y0 + 1) * fx;
         (a * (1.0 - fy) + b * fy) * self.scale
     }
 
+    /// The lookup along `dir`: the texel at the blend's top left and the fractions towards
+    /// the next column and row (see [`EnvMap::eval`]).
+    fn lookup(&self, dir: Vec3) -> (i64, i64, f32, f32) {
+        let uv = self.uv_from_dir(dir);
+        let x = uv[0] * self.image.width as f32 - 0.5;
+        let y = uv[1] * (self.image.height as i64 - 1).max(1) as f32;
+        let (x0, y0) = (x.floor(), y.floor());
+        (x0 as i64, y0 as i64, x - x0, y - y0)
+    }
+
+    /// The index in the image's pixels of column `x` (wrapping around) and row `y` (clamped).
+    fn texel_index(&self, x: i64, y: i64) -> usize {
+        let (w, h) = (self.image.width as i64, self.image.height as i64);
+        y.clamp(0, h - 1) as usize * self.image.width + x.rem_euclid(w) as usize
+    }
+
     /// The texels [`EnvMap::eval`] blends along `dir` (indices into the image's pixels) and
     /// their weights, before the scale.
     pub fn taps(&self, dir: Vec3) -> [(usize, f32); 4] {
-        let uv = self.uv_from_dir(dir);
-        let (w, h) = (self.image.width as i64, self.image.height as i64);
-        let x = uv[0] * w as f32 - 0.5;
-        let y = uv[1] * (h - 1).max(1) as f32;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let at = |xi: i64, yi: i64| yi.clamp(0, h - 1) as usize * self.image.width + xi.rem_euclid(w) as usize;
-        let (x0, y0) = (x0 as i64, y0 as i64);
+        let (x0, y0, fx, fy) = self.lookup(dir);
+        let at = |xi: i64, yi: i64| self.texel_index(xi, yi);
         [
             (at(x0, y0), (1.0 - fx) * (1.0 - fy)),
             (at(x0 + 1, y0), fx * (1.0 - fy)),
