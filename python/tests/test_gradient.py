@@ -3,6 +3,7 @@ determinism across threads, Ctrl-C and the GIL. Agreement with finite difference
 in Rust (crates/glint/tests/gradient.rs), with Mitsuba in test_gradient_mitsuba.py."""
 
 import _thread
+import pathlib
 import signal
 import threading
 
@@ -91,3 +92,22 @@ def test_keyboard_interrupt_stops_a_gradient_and_other_threads_run():
     # The GIL was free while the gradient ran; the scene still works.
     assert counter[0] > 10
     assert np.isfinite(glint.render_gradient(s, (RED,), ones(s), spp=1)[RED]).all()
+
+
+def test_texels_are_edited_as_images(tmp_path):
+    scene = glint.load_file(pathlib.Path(__file__).resolve().parents[2] / "tests" / "scenes" / "gradients" / "textured.xml")
+    params = glint.traverse(scene)
+    name = "materials.floor.reflectance"
+    texels = params[name]
+    assert texels.shape == (8, 8, 3) and texels.dtype == np.float32
+    before = glint.render(scene, spp=4, seed=1).image
+    params[name] = np.zeros((4, 2, 3), np.float32)  # any size
+    params.update()
+    assert glint.traverse(scene)[name].shape == (4, 2, 3)
+    assert glint.render(scene, spp=4, seed=1).image.sum() < before.sum()
+    with pytest.raises(TypeError, match="height, width, 3"):
+        params[name] = np.zeros((4, 4), np.float32)
+    with pytest.raises(glint.SceneError, match="not finite"):
+        params.update({name: np.full((2, 2, 3), np.nan, np.float32)})
+    # Nothing changed by the refused edit.
+    assert glint.traverse(scene)[name].shape == (4, 2, 3)

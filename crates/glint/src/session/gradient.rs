@@ -33,7 +33,7 @@ impl Session {
     /// The gradient of `sum(grad_image * image)` with respect to each parameter `names`
     /// names, for the image a path-traced render of `spp` samples per pixel with `seed` and
     /// a box filter makes (see `gradient`). `grad_image` is `width * height` colours, rows
-    /// from the top. Runs on the current rayon pool; `cancel` stops it between rows.
+    /// from the top. Runs on the current rayon pool; `cancel` stops it within 64 samples.
     pub fn render_gradient(
         &mut self,
         names: &[String],
