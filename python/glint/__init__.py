@@ -365,6 +365,10 @@ def write_image(
     _glint.write_image(path, np.ascontiguousarray(image, dtype=np.float32), layers)
 
 
+#: The value of an image parameter whose texels are not read yet.
+_UNREAD = object()
+
+
 class SceneParameters(MutableMapping):
     """The editable parameters of a scene, by name (see ``traverse``).
 
@@ -387,7 +391,8 @@ class SceneParameters(MutableMapping):
             if isinstance(v, tuple):
                 kind, data = v
                 self._kinds[name] = kind
-                self._values[name] = np.array(data, dtype=np.float32 if kind == "image" else np.float64)
+                # An image's texels are read from its file only when asked for.
+                self._values[name] = _UNREAD if data is None else np.array(data, dtype=np.float64)
             else:
                 self._kinds[name] = "float"
                 self._values[name] = float(v)
@@ -411,6 +416,9 @@ class SceneParameters(MutableMapping):
             v = self._pending[key]
         else:
             v = self._values[key]
+            if v is _UNREAD:
+                _, data = self._scene._param(key)
+                v = self._values[key] = np.array(data, dtype=np.float32)
         return v.copy() if isinstance(v, np.ndarray) else v
 
     def __setitem__(self, key: str, value: Any) -> None:
@@ -440,6 +448,14 @@ class SceneParameters(MutableMapping):
         if a.shape != expected:
             raise TypeError(f"{key} takes an array of shape {expected}, not {a.shape}")
         self._pending[key] = a
+
+    def __contains__(self, key: object) -> bool:
+        # Without reading the value (an image's texels come from its file).
+        try:
+            self._name(key)  # type: ignore[arg-type]
+        except KeyError:
+            return False
+        return True
 
     def __delitem__(self, key: str) -> None:
         raise TypeError("scene parameters cannot be removed")

@@ -111,3 +111,16 @@ def test_texels_are_edited_as_images(tmp_path):
         params.update({name: np.full((2, 2, 3), np.nan, np.float32)})
     # Nothing changed by the refused edit.
     assert glint.traverse(scene)[name].shape == (4, 2, 3)
+
+
+def test_traverse_reads_an_image_only_when_asked(tmp_path):
+    gradients = pathlib.Path(__file__).resolve().parents[2] / "tests" / "scenes" / "gradients"
+    for f in ("textured.xml", "texture.exr"):
+        (tmp_path / f).write_bytes((gradients / f).read_bytes())
+    scene = glint.load_file(tmp_path / "textured.xml")
+    (tmp_path / "texture.exr").unlink()
+    params = glint.traverse(scene)  # lists the texture without reading its file
+    assert "materials.floor.reflectance" in params
+    assert params["shapes.light.emission"].shape == (3,)
+    with pytest.raises(KeyError, match="cannot be read"):
+        params["floor.reflectance.data"]

@@ -200,15 +200,25 @@ impl Scene {
     }
 
     /// Editable parameters as (name, value) pairs; a colour is ("color", [r, g, b]), a
-    /// matrix ("matrix", rows), a number a float.
+    /// matrix ("matrix", rows), a number a float, an image ("image", None): its texels are
+    /// read by `_param`, when asked for.
     fn _params<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let items = self
             .session
-            .params()
+            .param_listing()
             .iter()
-            .map(|p| Ok((p.name.clone(), value_to_py(py, &p.value)?)))
+            .map(|(name, value)| match value {
+                Some(v) => Ok((name.clone(), value_to_py(py, v)?)),
+                None => Ok((name.clone(), ("image", py.None()).into_pyobject(py)?.into_any())),
+            })
             .collect::<PyResult<Vec<_>>>()?;
         PyList::new(py, items)
+    }
+
+    /// One parameter's value, as `_params` gives it (an image's texels included).
+    fn _param<'py>(&mut self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        let value = self.session.param(name).map_err(|e| PyKeyError::new_err(e.to_string()))?;
+        value_to_py(py, &value)
     }
 
     /// The name `_params` gives a parameter named `name` or by an alias of it (Mitsuba's

@@ -399,6 +399,30 @@ impl Session {
             .collect()
     }
 
+    /// [`Session::params`]' names, each with its value but an image's (`None`): images are
+    /// read from their files, so a listing leaves them to [`Session::param`].
+    pub fn param_listing(&mut self) -> Vec<(String, Option<ParamValue>)> {
+        slots(&mut self.desc)
+            .into_iter()
+            .filter_map(|e| match e.slot {
+                Slot::Texels { .. } => Some((e.name, None)),
+                Slot::Float(_) | Slot::Color(_) | Slot::Matrix(_) | Slot::OptionalMatrix(_) => {
+                    e.slot.get().map(|value| (e.name, Some(value)))
+                }
+            })
+            .collect()
+    }
+
+    /// The value of the parameter named `name` or by an alias of it.
+    pub fn param(&mut self, name: &str) -> Result<ParamValue, Error> {
+        let name = resolve_param_name(&mut self.desc, name)?;
+        slots(&mut self.desc).into_iter().find(|e| e.name == name).and_then(|e| e.slot.get()).ok_or_else(|| {
+            Error::new(format!(
+                "'{name}' has no value to read (an image whose file cannot be read, or an unset camera transform)"
+            ))
+        })
+    }
+
     /// Sets parameters; on an error (an unknown name, a wrong kind of value, a value the
     /// scene cannot take) nothing is changed. Rebuilds as little as the edits need (see the
     /// module doc).
