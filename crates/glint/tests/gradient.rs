@@ -510,3 +510,30 @@ fn textured_area_light_gradients() {
     assert!((a - b).abs() <= z * se, "BSDF sampling {a} ± {se_a}, MIS {b} ± {se_b}");
     assert!(z * se < 0.2 * a.abs(), "cannot see a 20% error: {a} ± {se}");
 }
+
+/// Texels that do not fill their image, or are not finite, are refused before the build
+/// whichever way they come (an edit, or a description made elsewhere), in one line.
+#[test]
+fn malformed_texels_are_refused() {
+    let dir = ScratchDir::new("gradient-bad-texels");
+    let sky: Vec<Rgb> = vec![Rgb::WHITE; 8 * 4];
+    glint::io::write_image(&glint::io::Image { width: 8, height: 4, pixels: sky }, &dir.join("sky.exr")).unwrap();
+    let texture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/scenes/gradients/texture.exr");
+    std::fs::write(dir.join("scene.json"), TEXEL_SCENE.replace("TEXTURE", &texture.to_string_lossy())).unwrap();
+    let short = glint::describe::Texels { width: 4, height: 4, pixels: vec![Rgb::WHITE; 15] };
+    let nan = glint::describe::Texels { width: 1, height: 1, pixels: vec![rgb(f32::NAN, 0.0, 0.0)] };
+    for (bad, says) in [(short, "cannot hold 15"), (nan, "not finite")] {
+        // Through an edit: refused, nothing changed.
+        let mut session = Session::open(&dir.join("scene.json"), &ReadOptions::default()).unwrap();
+        let e = session.set_params(&[Param { name: "lights.0.data".into(), value: ParamValue::Image(bad.clone()) }]);
+        let msg = e.unwrap_err().to_string();
+        assert!(msg.contains(says) && !msg.contains('\n'), "{msg}");
+        // Through the description: the build refuses it.
+        let mut desc = session.description().clone();
+        if let glint::describe::LightKind::EnvMap { texels, .. } = &mut desc.lights[0].light {
+            *texels = Some(bad.clone());
+        }
+        let msg = Session::from_description(desc).world().err().expect("refused").to_string();
+        assert!(msg.contains(says) && !msg.contains('\n'), "{msg}");
+    }
+}

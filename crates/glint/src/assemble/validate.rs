@@ -4,7 +4,7 @@
 
 use crate::describe::{CameraDesc, FilmDesc, Geometry, IntegratorDesc, LightKind, Matrix4, PixelFilter};
 
-use crate::describe::checks::{color, texture};
+use crate::describe::checks::{color, texels, texture};
 use crate::error::{Error, SourceLoc};
 use crate::materials::SceneDesc;
 use crate::math::{Rgb, Vec3};
@@ -175,10 +175,11 @@ fn light(l: &LightKind) -> Result<(), String> {
             color(*irradiance, "irradiance")
         }
         LightKind::Constant { radiance } => color(*radiance, "radiance"),
-        LightKind::EnvMap { scale, to_world, .. } => {
+        LightKind::EnvMap { scale, to_world, texels: t, .. } => {
             if !(*scale >= 0.0 && scale.is_finite()) {
                 return Err(format!("envmap scale {scale} must be finite and at least 0"));
             }
+            t.as_ref().map_or(Ok(()), texels)?;
             matrix(to_world, "to_world")
         }
         LightKind::TexturedSpot { to_world, intensity, cutoff_degrees, beam_degrees, .. } => {

@@ -2,7 +2,7 @@
 //! textures finite and not negative, indices of refraction and roughness positive. Each
 //! returns a message naming the parameter, which the caller places.
 
-use super::{Roughness, ScalarTexture, TextureDesc};
+use super::{Roughness, ScalarTexture, Texels, TextureDesc};
 use crate::math::Rgb;
 
 /// A colour: every channel finite and not negative.
@@ -23,7 +23,18 @@ pub fn uv(scale: &[f32; 2], offset: &[f32; 2]) -> Result<(), String> {
     }
 }
 
-/// A texture's colours (named `what` when constant), uv transform and attribute name.
+/// Texels given as data: at least one, as many as the size says, all finite.
+pub fn texels(t: &Texels) -> Result<(), String> {
+    if t.width == 0 || t.height == 0 || t.width.checked_mul(t.height) != Some(t.pixels.len()) {
+        return Err(format!("an image of {}x{} texels cannot hold {}", t.width, t.height, t.pixels.len()));
+    }
+    match t.pixels.iter().position(|p| !p.is_finite()) {
+        Some(i) => Err(format!("texel ({}, {}) is not finite", i % t.width, i / t.width)),
+        None => Ok(()),
+    }
+}
+
+/// A texture's colours (named `what` when constant), uv transform, texels and attribute name.
 pub fn texture(t: &TextureDesc, what: &str) -> Result<(), String> {
     match t {
         TextureDesc::Constant { color: c } => color(*c, what)?,
@@ -32,7 +43,10 @@ pub fn texture(t: &TextureDesc, what: &str) -> Result<(), String> {
             color(*color1, "color1")?;
             uv(uv_scale, uv_offset)?;
         }
-        TextureDesc::Bitmap { uv_scale, uv_offset, .. } => uv(uv_scale, uv_offset)?,
+        TextureDesc::Bitmap { uv_scale, uv_offset, texels: t, .. } => {
+            uv(uv_scale, uv_offset)?;
+            t.as_ref().map_or(Ok(()), texels)?;
+        }
         TextureDesc::MeshAttribute { name, scale, .. } => {
             if !scale.is_finite() {
                 return Err(format!("mesh attribute '{name}': scale {scale} must be finite"));

@@ -1,7 +1,7 @@
 //! The adjoint pass's view of a replayed path: at each event, the adjoint radiance times
 //! the event's derivative with respect to each parameter it depends on, added to the sums.
 
-use super::params::{bitmap_taps, LightParam, LightProbe};
+use super::params::{bitmap_taps, channel_derivative, scale_derivative, LightParam, LightProbe};
 use super::{fixed, ParamSet};
 use crate::integrators::{shadow_ray, transmittance, Counters, NextEvent, PathObserver, Scattering};
 use crate::lights::Light;
@@ -62,7 +62,7 @@ impl<'a> Adjoint<'a> {
         }
         let p: TexturePoint = self.world.texture_point(u.si);
         for probe in probes {
-            let v = self.dot(weight(probe.derivative(&p, u.bsdf, u.wo, u.wi)));
+            let v = self.dot(weight(probe.difference.derivative(&p, u.bsdf, u.wo, u.wi)));
             self.add_scalar(probe.index, v);
         }
         for texture in textures {
@@ -101,8 +101,12 @@ impl<'a> Adjoint<'a> {
                     let taps = bitmap_taps(probe.index, width, height, uv, p.uv);
                     self.add_taps(&taps, weight);
                 }
-                LightParam::Channel { .. } | LightParam::Scale { .. } => {
-                    let v = self.dot(weight * probe.derivative(le));
+                LightParam::Channel { c, value } => {
+                    let v = self.dot(weight * channel_derivative(le, c, value));
+                    self.add_scalar(probe.index, v);
+                }
+                LightParam::Scale { value } => {
+                    let v = self.dot(weight * scale_derivative(le, value));
                     self.add_scalar(probe.index, v);
                 }
             }

@@ -22,7 +22,7 @@
 //!
 //! Derivatives at a vertex (see `params`): a material parameter's by a symmetric difference
 //! of the material's own BSDF value, built with the parameter moved up and down
-//! ([`MaterialProbe`]), at the same texture point and directions (exact up to rounding where
+//! ([`BsdfDifference`]), at the same texture point and directions (exact up to rounding where
 //! the BSDF is affine in the parameter, as a Lambertian reflectance is); a light's radiance,
 //! intensity or scale analytically (emission is linear in each).
 //!
@@ -32,7 +32,7 @@
 mod adjoint;
 mod params;
 
-pub use params::{LightParam, LightProbe, MaterialProbe, ParamSet, TextureProbe};
+pub use params::{BsdfDifference, LightParam, LightProbe, MaterialProbe, ParamSet, TextureProbe};
 
 use crate::error::Error;
 use crate::integrators::{path_li, Counters, PathSettings, PathState};

@@ -5,19 +5,24 @@
 use crate::materials::{Material, ShadedBsdf, TexturePoint};
 use crate::math::{rgb, Rgb, Vec3};
 
-/// One scalar of a material parameter (a number, or one channel of a colour): the material
-/// built with that scalar moved down and up. At a vertex, the derivative of the BSDF value
-/// is `(f(plus) - f(minus)) * inv_step`, at the same texture point and directions.
-pub struct MaterialProbe {
-    /// The gradient entry it feeds.
-    pub index: usize,
+/// A material built with one scalar of a parameter moved down and up. At a vertex, the
+/// derivative of the BSDF value is `(f(plus) - f(minus)) * inv_step`, at the same texture
+/// point and directions.
+pub struct BsdfDifference {
     pub minus: Material,
     pub plus: Material,
     /// One over the distance between the two values.
     pub inv_step: f32,
 }
 
-impl MaterialProbe {
+/// One scalar of a material parameter (a number, or one channel of a colour) and the
+/// gradient entry it feeds.
+pub struct MaterialProbe {
+    pub index: usize,
+    pub difference: BsdfDifference,
+}
+
+impl BsdfDifference {
     /// The derivative of the BSDF value (cosine included) towards `wo` from `wi`, tilted as
     /// the vertex's own BSDF is by a normal or bump map.
     #[inline]
@@ -37,7 +42,7 @@ pub struct TextureProbe {
     pub height: usize,
     /// The texture's (scale, offset) of surface uv.
     pub uv: [[f32; 2]; 2],
-    pub channels: [MaterialProbe; 3],
+    pub channels: [BsdfDifference; 3],
 }
 
 impl TextureProbe {
@@ -97,36 +102,32 @@ pub struct LightProbe {
     pub param: LightParam,
 }
 
-impl LightProbe {
-    /// The derivative of emitted radiance `le` with respect to the parameter. Emission is
-    /// linear in each parameter, so it is `le` per unit of the parameter; for a colour channel
-    /// whose value is zero, the unit response is read from another channel (the light's
-    /// geometry, falloff and distance act alike on all three).
-    #[inline]
-    pub fn derivative(&self, le: Rgb) -> Rgb {
-        match self.param {
-            // Per texel: see the adjoint pass.
-            LightParam::Texels { .. } | LightParam::AreaTexels { .. } => Rgb::BLACK,
-            LightParam::Scale { value } => {
-                if value != 0.0 {
-                    le / value
-                } else {
-                    Rgb::BLACK
-                }
-            }
-            LightParam::Channel { c, value } => {
-                let (le, value) = (le.to_array(), value.to_array());
-                let unit = if value[c] != 0.0 {
-                    le[c] / value[c]
-                } else {
-                    (0..3).find(|&k| value[k] != 0.0).map_or(0.0, |k| le[k] / value[k])
-                };
-                let mut d = [0.0; 3];
-                d[c] = unit;
-                rgb(d[0], d[1], d[2])
-            }
-        }
+/// The derivative of emitted radiance `le` with respect to a scale of value `value` it is
+/// proportional to (emission is linear in each light parameter: `le` per unit).
+#[inline]
+pub fn scale_derivative(le: Rgb, value: f32) -> Rgb {
+    if value != 0.0 {
+        le / value
+    } else {
+        Rgb::BLACK
     }
+}
+
+/// The derivative of emitted radiance `le` with respect to channel `c` of a colour `value`
+/// it is proportional to, channel by channel: `le` per unit in that channel. Where that
+/// channel's value is zero, the unit response is read from another channel (the light's
+/// geometry, falloff and distance act alike on all three).
+#[inline]
+pub fn channel_derivative(le: Rgb, c: usize, value: Rgb) -> Rgb {
+    let (le, value) = (le.to_array(), value.to_array());
+    let unit = if value[c] != 0.0 {
+        le[c] / value[c]
+    } else {
+        (0..3).find(|&k| value[k] != 0.0).map_or(0.0, |k| le[k] / value[k])
+    };
+    let mut d = [0.0; 3];
+    d[c] = unit;
+    rgb(d[0], d[1], d[2])
 }
 
 /// Every parameter of a gradient render, by the material or light it belongs to.

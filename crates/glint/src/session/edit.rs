@@ -54,23 +54,6 @@ impl ParamValue {
     }
 }
 
-/// Texels an edit may set: at least one, as many as the size says, all finite.
-fn check_texels(name: &str, t: &Texels) -> Result<(), Error> {
-    if t.width == 0 || t.height == 0 || t.pixels.len() != t.width * t.height {
-        return Err(Error::new(format!(
-            "{name}: an image of {}x{} needs {} texels, not {}",
-            t.width,
-            t.height,
-            t.width * t.height,
-            t.pixels.len()
-        )));
-    }
-    if let Some(i) = t.pixels.iter().position(|p| !p.is_finite()) {
-        return Err(Error::new(format!("{name}: texel ({}, {}) is not finite", i % t.width, i / t.width)));
-    }
-    Ok(())
-}
-
 /// A named parameter and its value.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Param {
@@ -104,7 +87,7 @@ impl Slot<'_> {
             (Slot::Matrix(v), ParamValue::Matrix(x)) => *v = x,
             (Slot::OptionalMatrix(v), ParamValue::Matrix(x)) => *v = Some(x),
             (Slot::Texels { texels, .. }, ParamValue::Image(t)) => {
-                check_texels(name, &t)?;
+                crate::describe::checks::texels(&t).map_err(|m| Error::new(format!("{name}: {m}")))?;
                 *texels = Some(t);
             }
             (slot, value) => {

@@ -10,7 +10,8 @@ use crate::describe::PixelFilter;
 use crate::describe::Texels;
 use crate::error::Error;
 use crate::gradient::{
-    render_gradient, GradientJob, LightParam, LightProbe, MaterialProbe, ParamGradient, ParamSet, TextureProbe,
+    render_gradient, BsdfDifference, GradientJob, LightParam, LightProbe, MaterialProbe, ParamGradient, ParamSet,
+    TextureProbe,
 };
 use crate::integrators::Integrator;
 use crate::lights::Light;
@@ -64,15 +65,15 @@ impl Session {
         let layout = self.layout.as_ref().expect("a built world has a layout");
         let mut set = ParamSet::default();
         let mut out = Vec::new();
-        let mut desc = self.desc.clone();
+        let desc = &mut self.desc;
         let mut canonical = Vec::new();
         for name in names {
-            let c = resolve_param_name(&mut desc, name)?;
+            let c = resolve_param_name(desc, name)?;
             if canonical.contains(&c) {
                 return Err(Error::new(format!("'{name}' is asked for twice")));
             }
             canonical.push(c.clone());
-            let shape = add_param(&mut set, &mut desc, &world, layout, &c)?;
+            let shape = add_param(&mut set, desc, &world, layout, &c)?;
             let size = shape.iter().product();
             out.push(ParamGradient { name: name.clone(), shape, values: vec![0.0; size] });
         }
@@ -97,7 +98,6 @@ fn add_param(
     layout: &WorldLayout,
     name: &str,
 ) -> Result<Vec<usize>, Error> {
-    let materials = desc.materials.clone();
     let mut entries = slots(desc);
     let Some(position) = entries.iter().position(|e| e.name == name) else {
         return Err(Error::new(format!("no parameter called '{name}'")));
@@ -108,7 +108,10 @@ fn add_param(
     let slot = entries.swap_remove(position).slot;
     let not = |why: &str| Error::new(format!("'{name}' is not differentiable: {why}"));
     match owner {
-        Owner::Material(m) => material_param(set, &materials[m], m, rank, name),
+        Owner::Material(m) => {
+            drop(entries);
+            material_param(set, &desc.materials[m], m, rank, name)
+        }
         Owner::Shape(s) => {
             let lights: Vec<usize> = layout.shape_instances[s]
                 .clone()
@@ -245,7 +248,7 @@ fn material_param(
     };
     // A side the material refuses (a roughness at zero, say) is the value itself: the
     // difference is then one-sided.
-    let mut probe = |index: usize, k: usize, v: f32, from: f32, d: &MaterialDesc| -> Result<MaterialProbe, Error> {
+    let mut probe = |k: usize, v: f32, from: f32, d: &MaterialDesc| -> Result<BsdfDifference, Error> {
         let step = (v.abs() * RELATIVE_STEP).max(MIN_STEP);
         let (lo, minus) = match moved(d, rank, k, from - step, &mut textures) {
             Some(x) => (from - step, x),
@@ -258,14 +261,14 @@ fn material_param(
         if !(hi > lo) {
             return Err(Error::new(format!("'{name}': the material accepts no value near {v} but {v}")));
         }
-        Ok(MaterialProbe { index, minus, plus, inv_step: 1.0 / (hi - lo) })
+        Ok(BsdfDifference { minus, plus, inv_step: 1.0 / (hi - lo) })
     };
     match value {
         Value::Scalars(values) => {
             for (k, &v) in values.iter().enumerate() {
                 let index = set.new_entry();
-                let p = probe(index, k, v, v, &desc)?;
-                set.add_material_probe(m, p);
+                let difference = probe(k, v, v, &desc)?;
+                set.add_material_probe(m, MaterialProbe { index, difference });
             }
             Ok(if values.len() == 1 { vec![] } else { vec![3] })
         }
@@ -279,9 +282,9 @@ fn material_param(
             let mut channels = Vec::with_capacity(3);
             for k in 0..3 {
                 let typical = t.pixels.iter().map(|p| p.to_array()[k].abs()).sum::<f32>() / t.pixels.len() as f32;
-                channels.push(probe(base, k, typical, 0.0, &with_texels)?);
+                channels.push(probe(k, typical, 0.0, &with_texels)?);
             }
-            let channels: [MaterialProbe; 3] = channels.try_into().map_err(|_| Error::new("three channels"))?;
+            let channels: [BsdfDifference; 3] = channels.try_into().map_err(|_| Error::new("three channels"))?;
             set.add_texture_probe(m, TextureProbe { base, width: t.width, height: t.height, uv, channels });
             Ok(vec![t.height, t.width, 3])
         }
