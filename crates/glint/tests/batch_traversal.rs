@@ -7,6 +7,8 @@
 //! reference binary BVH's; `occluded_batch` gives the single-ray occlusion answer. Batches of
 //! 0, 1, odd and large sizes (more rays than lanes, so lanes are refilled) and empty and
 //! one-leaf trees are covered, and hostile triangles (NaN, infinite) below `TriangleMesh`.
+//! Packet occlusion (`occluded_packets`) is held to the same single-ray answers, with rays
+//! leaving the packet never, at the default count, and always.
 
 use glint::accel::{BuildOptions, Bvh, BvhSplit, SimdPath, TriangleHit, TriangleWideBvh, BATCH_LANES};
 use glint::geometry::{MeshAccel, TriangleMesh};
@@ -109,7 +111,18 @@ fn check_batch(mesh: &TriangleMesh, rays: &[Ray]) -> Result<(), TestCaseError> {
             blocked.fill(false);
         }
         mesh.occluded_batch_with(rays, &mut blocked, path);
+        let packets: Vec<Vec<bool>> = PACKET_SPLITS
+            .iter()
+            .map(|&split| {
+                let mut b = vec![rays.len() % 2 == 1; rays.len()];
+                mesh.occluded_packets_with(rays, &mut b, path, split);
+                b
+            })
+            .collect();
         for (i, ray) in rays.iter().enumerate() {
+            for (b, split) in packets.iter().zip(PACKET_SPLITS) {
+                prop_assert_eq!(b[i], blocked[i], "{} packets split below {}: ray {} {:?}", path, split, i, ray);
+            }
             let single = mesh.intersect_with(&mut ray.clone(), path);
             prop_assert_eq!(bits(&hits[i]), bits(&single), "{} ray {} of {}: {:?}", path, i, rays.len(), ray);
             let reference = mesh.intersect_reference(&mut ray.clone());
@@ -129,6 +142,10 @@ fn check_batch(mesh: &TriangleMesh, rays: &[Ray]) -> Result<(), TestCaseError> {
     }
     Ok(())
 }
+
+/// Where rays leave a packet: never (every node through the lanes), the renderer's count, and
+/// always (the single-ray fall-back from the root).
+const PACKET_SPLITS: [u32; 3] = [0, glint::accel::SINGLE_BELOW, 17];
 
 fn ray_param() -> impl Strategy<Value = (u8, f32, f32, f32, f32)> {
     (any::<u8>(), -1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0)
@@ -184,6 +201,11 @@ proptest! {
                 w8.intersect_batch(&rays, &mut h8, path);
                 w4.occluded_batch(&rays, &mut b4, path);
                 w8.occluded_batch(&rays, &mut b8, path);
+                let (mut p4, mut p8) = (vec![true; rays.len()], vec![true; rays.len()]);
+                w4.occluded_packets_split(&rays, &mut p4, path, 0);
+                w8.occluded_packets_split(&rays, &mut p8, path, 0);
+                prop_assert_eq!(&p4, &b4, "{} packets, wide4", path);
+                prop_assert_eq!(&p8, &b8, "{} packets, wide8", path);
                 for (i, ray) in rays.iter().enumerate() {
                     prop_assert_eq!(bits(&h4[i]), bits(&w4.intersect(&mut ray.clone(), path)), "{} {:?}", path, ray);
                     prop_assert_eq!(bits(&h8[i]), bits(&w8.intersect(&mut ray.clone(), path)), "{} {:?}", path, ray);
@@ -236,6 +258,9 @@ fn empty_and_one_leaf_trees() {
         empty.intersect_batch_with(&rays, &mut hits, path);
         empty.occluded_batch_with(&rays, &mut blocked, path);
         assert!(hits.iter().all(|h| h.is_none()) && blocked.iter().all(|&b| !b), "{path}");
+        blocked.fill(true);
+        empty.occluded_packets_with(&rays, &mut blocked, path, 0);
+        assert!(blocked.iter().all(|&b| !b), "{path} packets");
     }
     // One triangle: the root is a leaf.
     let one = mesh_from(&[(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)], &[], MeshAccel::Wide8);
@@ -256,6 +281,7 @@ fn empty_batch_touches_nothing() {
     for path in SimdPath::available() {
         mesh.intersect_batch_with(&[], &mut [], path);
         mesh.occluded_batch_with(&[], &mut [], path);
+        mesh.occluded_packets_with(&[], &mut [], path, 0);
     }
 }
 

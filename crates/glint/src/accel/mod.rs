@@ -6,6 +6,7 @@ mod binning;
 mod build;
 mod bvh;
 mod huge_pages;
+mod packet;
 pub mod simd;
 mod top_level;
 pub mod tri4;
@@ -18,6 +19,7 @@ pub use bvh::{
     BuildOptions, Bvh, BvhNode, BvhSplit, BvhStats, TraversalVisits, MAX_DEPTH, SAH_DEPTH_LIMIT, SAH_INTERSECT_COST,
     SAH_TRAVERSAL_COST,
 };
+pub use packet::SINGLE_BELOW;
 pub use simd::SimdPath;
 pub use top_level::{FlatMesh, TopLevelBvh};
 pub use triangle::{intersect_triangle, ShearedRay, TriangleHit};

@@ -433,18 +433,35 @@ impl<const W: usize> WideBvh<W> {
         if self.root == EMPTY_CHILD {
             return false;
         }
-        let nr = NodeRay::new(ray);
+        // SAFETY: the root of a non-empty tree; `S` is the caller's.
+        unsafe { self.occluded_from::<S>(self.root, ray, &NodeRay::new(ray), leaf) }
+    }
+
+    /// Any-hit traversal of the subtree at `start` (the packet traversal's single-ray
+    /// fall-back starts below the root).
+    ///
+    /// # Safety
+    /// `S` must be available on this CPU; `start` must be the root of a non-empty tree or a
+    /// node reference from a slot whose box the ray passes; `nr` must be `NodeRay::new(ray)`.
+    #[inline(always)]
+    pub(super) unsafe fn occluded_from<S: Isa>(
+        &self,
+        start: u32,
+        ray: &Ray,
+        nr: &NodeRay,
+        leaf: &mut impl AnyLeaf,
+    ) -> bool {
         let nodes: &[WideNode<W>] = &self.nodes;
         let mut stack: [MaybeUninit<u32>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut sp = 0usize;
-        let mut cur = self.root;
+        let mut cur = start;
         loop {
             if cur & LEAF_BIT == 0 {
                 // SAFETY: as in `traverse`: only hit slots' references are followed, and
                 // those are node indices written by `collapse`.
                 let node = unsafe { nodes.get_unchecked(cur as usize) };
                 let mut dist = [0.0f32; W];
-                let mut mask = S::node(node, &nr, ray.t_max, &mut dist);
+                let mut mask = S::node(node, nr, ray.t_max, &mut dist);
                 // Leaves first: one leaf test may end the query, where a subtree costs many
                 // node tests before it can (large occluders such as walls sit in shallow
                 // leaves).

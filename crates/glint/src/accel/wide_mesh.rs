@@ -3,6 +3,7 @@
 
 use super::bvh::Bvh;
 use super::huge_pages::PageBuf;
+use super::packet::{PacketLeaf, SINGLE_BELOW};
 #[cfg(target_arch = "x86_64")]
 use super::simd::{Avx2, Avx512, Sse};
 use super::simd::{Isa, Scalar, SimdPath};
@@ -10,6 +11,9 @@ use super::tri4::{Tri4, TriHits, TriRay};
 use super::triangle::TriangleHit;
 use super::wide::{leaf_range, leaf_ref, WideBvh, WideStats, LEAF_BIT};
 use super::wide::{AnyLeaf, ClosestLeaf};
+#[cfg(target_arch = "x86_64")]
+use crate::math::lanes::{Avx2x8, Avx512x16};
+use crate::math::lanes::{Lanes, One, MAX_LANES};
 use crate::math::{Ray, Vec3};
 use std::marker::PhantomData;
 
@@ -122,6 +126,33 @@ impl<S: Isa> AnyLeaf for Any<'_, S> {
             }
         }
         false
+    }
+}
+
+/// A packet's leaf tests: each lane's ray through [`Any`], with its triangle-test constants
+/// made once per packet.
+struct AnyPacket<'a, S> {
+    blocks: &'a [Tri4],
+    trs: [TriRay; MAX_LANES],
+    isa: PhantomData<S>,
+}
+
+impl<'a, S: Isa> AnyPacket<'a, S> {
+    #[inline(always)]
+    fn new(blocks: &'a [Tri4], rays: &[Ray]) -> AnyPacket<'a, S> {
+        let mut trs = [TriRay::new(&rays[0]); MAX_LANES];
+        for (tr, ray) in trs.iter_mut().zip(rays).skip(1) {
+            *tr = TriRay::new(ray);
+        }
+        AnyPacket { blocks, trs, isa: PhantomData }
+    }
+}
+
+impl<'a, S: Isa> PacketLeaf for AnyPacket<'a, S> {
+    type Single = Any<'a, S>;
+    #[inline(always)]
+    fn single(&self, lane: usize) -> Any<'a, S> {
+        Any { blocks: self.blocks, tr: self.trs[lane], isa: PhantomData }
     }
 }
 
@@ -308,6 +339,68 @@ impl<const W: usize> TriangleWideBvh<W> {
             |r| Any { blocks, tr: TriRay::new(r), isa: PhantomData },
             |i, b| blocked[i] = b,
         );
+    }
+
+    /// Occlusion of many rays in packets (see `packet.rs`): `blocked[i]` is
+    /// [`TriangleWideBvh::occluded`] of `rays[i]`, bit for bit; sixteen rays per packet on
+    /// the AVX-512 path, eight on AVX2, one (the single-ray traversal in the packet's
+    /// form) on the others.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn occluded_packets(&self, rays: &[Ray], blocked: &mut [bool], path: SimdPath) {
+        self.occluded_packets_split(rays, blocked, path, SINGLE_BELOW);
+    }
+
+    /// [`TriangleWideBvh::occluded_packets`] with rays leaving the packet where fewer than
+    /// `single_below` are active at a node (0: never), for tests and measurements; the
+    /// answers are the same for every value.
+    pub fn occluded_packets_split(&self, rays: &[Ray], blocked: &mut [bool], path: SimdPath, single_below: u32) {
+        assert_eq!(rays.len(), blocked.len(), "occluded_packets: one answer per ray");
+        let s = single_below;
+        // SAFETY (every arm): each path runs only where the CPU has it.
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 if path.is_available() => unsafe { self.occluded_packets_avx2(rays, blocked, s) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 if path.is_available() => unsafe { self.occluded_packets_avx512(rays, blocked, s) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.occluded_packets_generic::<Sse, One>(One, rays, blocked, s) },
+            _ => unsafe { self.occluded_packets_generic::<Scalar, One>(One, rays, blocked, s) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn occluded_packets_avx2(&self, rays: &[Ray], blocked: &mut [bool], single_below: u32) {
+        // SAFETY: this path runs only where AVX2 is available (`occluded_packets`).
+        let l = unsafe { Avx2x8::new_unchecked() };
+        self.occluded_packets_generic::<Avx2, Avx2x8>(l, rays, blocked, single_below)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    unsafe fn occluded_packets_avx512(&self, rays: &[Ray], blocked: &mut [bool], single_below: u32) {
+        // SAFETY: the AVX-512 path requires AVX-512F (`SimdPath::is_available`).
+        let l = unsafe { Avx512x16::new_unchecked() };
+        self.occluded_packets_generic::<Avx512, Avx512x16>(l, rays, blocked, single_below)
+    }
+
+    #[inline(always)]
+    unsafe fn occluded_packets_generic<S: Isa, L: Lanes>(
+        &self,
+        l: L,
+        rays: &[Ray],
+        blocked: &mut [bool],
+        single_below: u32,
+    ) {
+        for (r, b) in rays.chunks(L::N).zip(blocked.chunks_mut(L::N)) {
+            let leaf = AnyPacket::<S>::new(&self.blocks, r);
+            // SAFETY: `S` is available (this function's callers).
+            let bits = unsafe { self.tree.occluded_packet::<S, L, _>(l, r, &leaf, single_below) };
+            for (i, b) in b.iter_mut().enumerate() {
+                *b = bits >> i & 1 == 1;
+            }
+        }
     }
 
     /// Whether the tree is a single leaf (tiny meshes).

@@ -245,6 +245,17 @@ impl TriangleMesh {
         }
     }
 
+    /// Occlusion of many rays in packets (`TriangleWideBvh::occluded_packets`): `blocked[i]`
+    /// is `occluded_with(rays[i], path)`; rays leave a packet where fewer than `single_below`
+    /// are active. Panics if the slices differ in length.
+    pub fn occluded_packets_with(&self, rays: &[Ray], blocked: &mut [bool], path: SimdPath, single_below: u32) {
+        match &self.wide {
+            WideTris::W8(w) => w.occluded_packets_split(rays, blocked, path, single_below),
+            WideTris::W4(w) => w.occluded_packets_split(rays, blocked, path, single_below),
+            WideTris::None => self.occluded_batch_with(rays, blocked, path),
+        }
+    }
+
     /// Closest hit through the binary BVH: the reference implementation.
     #[inline]
     pub fn intersect_reference(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {

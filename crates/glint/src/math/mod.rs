@@ -3,6 +3,7 @@
 mod aabb;
 mod color;
 mod frame;
+pub mod lanes;
 mod ray;
 mod transform;
 mod vec3;

@@ -1,0 +1,220 @@
+//! Occlusion of packets of rays: up to [`Lanes::N`] rays traverse the wide BVH together, one
+//! ray per lane, so that a node is loaded once for all of them and the loop's bookkeeping
+//! (stack, masks, branches) is shared.
+//!
+//! A node's W children are tested one at a time against all the packet's rays: lane i
+//! computes, for ray i and that child, exactly the slab test of the single-ray kernels (the
+//! same near and far rows, chosen per lane by the direction's sign, the same operations and
+//! the same `maxps` rule), so a ray's bit says what the single-ray test would say. Leaves
+//! are tested ray by ray through the single-ray triangle kernels. Where fewer than
+//! [`SINGLE_BELOW`] rays are still active at a node, each goes on alone from there through
+//! the single-ray traversal (as Embree's hybrid traversal does), which wastes no lanes.
+//!
+//! Any-hit queries do not shorten rays, so which boxes a ray passes does not depend on the
+//! order nodes are visited in: a ray is reported blocked exactly when some leaf it reaches
+//! through boxes it passes holds a triangle it hits, the single-ray answer (the tests compare
+//! them ray by ray, special rays included).
+
+use super::simd::Isa;
+use super::wide::{
+    leaf_mask, leaf_range, AnyLeaf, NodeRay, WideBvh, WideNode, EMPTY_CHILD, FAR_SCALE, LEAF_BIT, STACK,
+};
+use crate::math::lanes::{Lanes, MAX_LANES};
+use crate::math::Ray;
+use std::mem::MaybeUninit;
+
+/// Active rays at a node below which they leave the packet and go on one by one. Measured
+/// (BENCHMARKS.md, "Packets of shadow rays").
+pub const SINGLE_BELOW: u32 = 2;
+
+/// What a packet traversal tests at a leaf: lane `lane`'s ray, through the single-ray leaf
+/// test (which is also what the single-ray fall-back uses).
+pub trait PacketLeaf {
+    type Single: AnyLeaf;
+    fn single(&self, lane: usize) -> Self::Single;
+}
+
+/// The packet's rays in lanes: what [`NodeRay`] holds per ray, one vector per component,
+/// and whether each direction component is negative (which slab row is the near one).
+struct PacketRays<L: Lanes> {
+    o: [L::F; 3],
+    inv: [L::F; 3],
+    neg: [L::M; 3],
+    t_min: L::F,
+    t_max: L::F,
+}
+
+impl<L: Lanes> PacketRays<L> {
+    /// Lanes past `nrs.len()` repeat ray 0 (their bits are never used).
+    #[inline(always)]
+    fn new(l: L, nrs: &[NodeRay], rays: &[Ray]) -> PacketRays<L> {
+        let mut soa = [[0.0f32; MAX_LANES]; 8];
+        for i in 0..L::N {
+            let k = if i < nrs.len() { i } else { 0 };
+            let nr = &nrs[k];
+            for a in 0..3 {
+                soa[a][i] = nr.o[a];
+                soa[3 + a][i] = nr.inv[a];
+            }
+            soa[6][i] = nr.t_min;
+            soa[7][i] = rays[k].t_max;
+        }
+        let inv = [l.load(&soa[3]), l.load(&soa[4]), l.load(&soa[5])];
+        PacketRays {
+            o: [l.load(&soa[0]), l.load(&soa[1]), l.load(&soa[2])],
+            inv,
+            // `NodeRay::new` takes the near row from the sign of the reciprocal.
+            neg: [l.sign(inv[0]), l.sign(inv[1]), l.sign(inv[2])],
+            t_min: l.load(&soa[6]),
+            t_max: l.load(&soa[7]),
+        }
+    }
+
+    /// The rays that pass child `c`'s box: per lane, the single-ray kernels' slab test.
+    #[inline(always)]
+    fn hits<const W: usize>(&self, l: L, node: &WideNode<W>, c: usize) -> u32 {
+        let slab = |row: usize, a: usize| l.mul(l.sub(l.splat(node.bounds[row][c]), self.o[a]), self.inv[a]);
+        let (lo, hi) = ([slab(0, 0), slab(1, 1), slab(2, 2)], [slab(3, 0), slab(4, 1), slab(5, 2)]);
+        let near = |a: usize| l.select(self.neg[a], hi[a], lo[a]);
+        let far = |a: usize| l.select(self.neg[a], lo[a], hi[a]);
+        let t_near = l.max(near(0), l.max(near(1), l.max(near(2), self.t_min)));
+        let t_far = l.min(far(0), l.min(far(1), l.min(far(2), self.t_max)));
+        l.bits(l.le(t_near, l.mul(t_far, l.splat(FAR_SCALE))))
+    }
+}
+
+impl<const W: usize> WideBvh<W> {
+    /// Which of `rays` (at most `L::N`) are blocked: bit i for `rays[i]`, each exactly
+    /// [`WideBvh::occluded`]'s answer; `leaf` tests a lane's ray at a leaf.
+    ///
+    /// Rays leave the packet at nodes where fewer than `single_below` are active (see the
+    /// module doc; the answers do not depend on it).
+    ///
+    /// Panics if `rays` is empty or longer than `L::N`.
+    ///
+    /// # Safety
+    /// `S` must be available on this CPU (see [`Isa`]).
+    #[inline(always)]
+    pub unsafe fn occluded_packet<S: Isa, L: Lanes, P: PacketLeaf>(
+        &self,
+        l: L,
+        rays: &[Ray],
+        leaf: &P,
+        single_below: u32,
+    ) -> u32 {
+        let n = rays.len();
+        assert!(n >= 1 && n <= L::N, "occluded_packet: 1 to {} rays", L::N);
+        let root = self.root();
+        if root == EMPTY_CHILD {
+            return 0;
+        }
+        let mut nrs = [NodeRay::new(&rays[0]); MAX_LANES];
+        for (nr, ray) in nrs.iter_mut().zip(rays).skip(1) {
+            *nr = NodeRay::new(ray);
+        }
+        let nrs = &nrs[..n];
+        let packet = PacketRays::<L>::new(l, nrs, rays);
+        let all = u32::MAX >> (32 - n);
+        let mut blocked = 0u32;
+        // Tests lane `i`'s ray against a leaf, through the single-ray leaf test.
+        let test_leaf = |i: usize, child: u32| {
+            let (first, count) = leaf_range(child);
+            leaf.single(i).test(first, count, &rays[i])
+        };
+        let nodes: &[WideNode<W>] = self.nodes();
+        let mut stack: [MaybeUninit<(u32, u32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
+        let mut sp = 0usize;
+        let (mut cur, mut active) = (root, all);
+        loop {
+            if cur & LEAF_BIT != 0 {
+                // Only the root is reached as a leaf (leaf children are tested in their
+                // parent); untraceable rays skip it as the single-ray traversal does.
+                for i in lanes(active) {
+                    if !nrs[i].t_min.is_nan() && test_leaf(i, cur) {
+                        blocked |= 1 << i;
+                    }
+                }
+            } else if active.count_ones() < single_below {
+                for i in lanes(active) {
+                    // SAFETY: `cur` is a node index that ray i's slab test passed (the root, or
+                    // a child reference followed below), `S` is available (this function's
+                    // contract), and `nrs[i]` is ray i's.
+                    if unsafe { self.occluded_from::<S>(cur, &rays[i], &nrs[i], &mut leaf.single(i)) } {
+                        blocked |= 1 << i;
+                    }
+                }
+            } else {
+                // SAFETY: `cur` is the root or a reference without the leaf bit from a slot
+                // that some ray's slab test passed; empty slots are never passed (see
+                // `NodeRay::new`: lane i computes ray i's single-ray test), and `collapse` wrote
+                // every other such reference as the index of a node it pushed.
+                let node = unsafe { nodes.get_unchecked(cur as usize) };
+                let leaf_bits = leaf_mask(node);
+                let mut passed = [0u32; W];
+                for (c, m) in passed.iter_mut().enumerate() {
+                    // `collapse` fills a node's slots in order: the first empty one ends them.
+                    if node.children[c] == EMPTY_CHILD {
+                        break;
+                    }
+                    *m = packet.hits(l, node, c) & active;
+                }
+                // Leaves first, as the single-ray traversal does: a hit may end lanes.
+                for c in lanes(leaf_bits) {
+                    for i in lanes(passed[c] & !blocked) {
+                        if test_leaf(i, node.children[c]) {
+                            blocked |= 1 << i;
+                        }
+                    }
+                }
+                if blocked == all {
+                    return blocked;
+                }
+                let mut next: Option<(u32, u32)> = None;
+                for c in lanes(!leaf_bits & (u32::MAX >> (32 - W))) {
+                    let m = passed[c] & !blocked;
+                    if m == 0 {
+                        continue;
+                    }
+                    match next {
+                        None => next = Some((node.children[c], m)),
+                        Some(_) => {
+                            // SAFETY: a node pushes at most W - 1 entries (one child goes on
+                            // as `cur`), the bound of the single-ray traversal's stack (see
+                            // `STACK`), which `collapse` checked against the tree's depth.
+                            unsafe { stack.get_unchecked_mut(sp).write((node.children[c], m)) };
+                            sp += 1;
+                        }
+                    }
+                }
+                if let Some((c, m)) = next {
+                    (cur, active) = (c, m);
+                    continue;
+                }
+            }
+            loop {
+                if sp == 0 {
+                    return blocked;
+                }
+                sp -= 1;
+                // SAFETY: entries `0..sp` were written above.
+                let (c, m) = unsafe { stack.get_unchecked(sp).assume_init() };
+                if m & !blocked != 0 {
+                    (cur, active) = (c, m & !blocked);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// The set bits of `mask`, lowest first.
+#[inline(always)]
+fn lanes(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            i
+        })
+    })
+}
