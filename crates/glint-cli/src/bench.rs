@@ -3,7 +3,8 @@
 //! for occlusion, several times; the best run counts, as timings on a shared machine only
 //! ever err on the slow side. `--batch` also traces them through the batch API (several rays
 //! in flight per thread), in runs interleaved with the single-ray ones so that the two are
-//! measured under the same load, and checks that both give the same answers ray by ray.
+//! measured under the same load, and checks that both give the same answers ray by ray;
+//! occlusion is also traced in packets (8 or 16 rays per instruction, `packet.rs`).
 
 use crate::bench_curves::{bench_curves, CurveBench};
 use crate::{meshsrc, rays};
@@ -54,6 +55,10 @@ pub struct BenchArgs {
     /// Also trace through the batch API and report its Mrays/s beside the single-ray figures.
     #[arg(long)]
     batch: bool,
+    /// With --batch: rays leave an occlusion packet where fewer than this many are active at
+    /// a node (0: never).
+    #[arg(long, default_value_t = glint::accel::SINGLE_BELOW)]
+    packet_split: u32,
 }
 
 pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
@@ -107,6 +112,8 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
     let mut hits: Vec<Option<(u32, TriangleHit)>> = vec![None; rays.len()];
     let mut batch_hits = hits.clone();
     let mut batch_blocked = vec![false; rays.len()];
+    let mut packet_blocked = vec![false; rays.len()];
+    let mut packet_occluded_s = f64::INFINITY;
     let (mut closest_s, mut occluded_s) = (f64::INFINITY, f64::INFINITY);
     let (mut batch_closest_s, mut batch_occluded_s) = (f64::INFINITY, f64::INFINITY);
     let mut blocked = vec![false; rays.len()];
@@ -146,6 +153,12 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
                     .zip(rays.par_chunks(CHUNK))
                     .for_each(|(b, r)| mesh.occluded_batch_with(r, b, simd))
             }));
+            packet_occluded_s = packet_occluded_s.min(timed(&mut || {
+                packet_blocked
+                    .par_chunks_mut(CHUNK)
+                    .zip(rays.par_chunks(CHUNK))
+                    .for_each(|(b, r)| mesh.occluded_packets_with(r, b, simd, a.packet_split))
+            }));
         }
     }
     let hit_count = hits.iter().filter(|h| h.is_some()).count();
@@ -155,6 +168,10 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
     }
     if a.batch {
         check_batch(&hits, &blocked, &batch_hits, &batch_blocked)?;
+        if let Some(i) = (0..rays.len()).find(|&i| packet_blocked[i] != blocked[i]) {
+            let (s, p) = (blocked[i], packet_blocked[i]);
+            return Err(format!("internal error: ray {i}: single-ray occlusion {s}, packet occlusion {p}"));
+        }
     }
     if let Some(p) = &a.hits {
         let bytes: Vec<u8> = hits.iter().flat_map(|h| h.map_or(f32::INFINITY, |h| h.1.t).to_le_bytes()).collect();
@@ -188,6 +205,10 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
         // Same-run ratios: the figures that mean something on a shared machine.
         o.insert("batch_closest_speedup".into(), (closest_s / batch_closest_s).into());
         o.insert("batch_occluded_speedup".into(), (occluded_s / batch_occluded_s).into());
+        o.insert("packet_lanes".into(), packet_lanes(simd).into());
+        o.insert("packet_split".into(), a.packet_split.into());
+        o.insert("packet_occluded_mrays_per_s".into(), (n / packet_occluded_s / 1e6).into());
+        o.insert("packet_occluded_speedup".into(), (occluded_s / packet_occluded_s).into());
     }
     print_result(&out, a.json);
     Ok(())
@@ -205,6 +226,15 @@ fn print_result(out: &serde_json::Value, json: bool) {
 
 /// The batch API must give each ray the single-ray answer: the same triangle and the same
 /// distance and barycentrics, bit for bit, and the same occlusion.
+/// Rays per occlusion packet on a SIMD path (`TriangleWideBvh::occluded_packets`).
+fn packet_lanes(simd: SimdPath) -> usize {
+    match simd {
+        SimdPath::Avx512 => 16,
+        SimdPath::Avx2 => 8,
+        SimdPath::Sse | SimdPath::Scalar => 1,
+    }
+}
+
 fn check_batch(
     single: &[Option<(u32, TriangleHit)>],
     single_blocked: &[bool],

@@ -144,7 +144,8 @@ pub struct RunArgs {
     pub film_out: Option<PathBuf>,
     /// How paths are scheduled: wavefront (a tile's paths advanced together, a bounce at a
     /// time; the default), wavefront-interleaved (the same, each batch traced with several
-    /// rays in flight) or one-path (each path to its end). Same image under each.
+    /// rays in flight), wavefront-packets (the same, shadow rays traced in packets of 8 or
+    /// 16) or one-path (each path to its end). Same image under each.
     #[arg(long, default_value = "wavefront")]
     pub schedule: Schedule,
     /// Serve a live view of the render in the browser at ADDR (HOST:PORT or PORT; default

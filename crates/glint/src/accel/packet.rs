@@ -49,6 +49,7 @@ impl<L: Lanes> PacketRays<L> {
     #[inline(always)]
     fn new(l: L, nrs: &[NodeRay], rays: &[Ray]) -> PacketRays<L> {
         let mut soa = [[0.0f32; MAX_LANES]; 8];
+        #[allow(clippy::needless_range_loop)] // lane `i` of eight arrays
         for i in 0..L::N {
             let k = if i < nrs.len() { i } else { 0 };
             let nr = &nrs[k];
@@ -73,12 +74,18 @@ impl<L: Lanes> PacketRays<L> {
     /// The rays that pass child `c`'s box: per lane, the single-ray kernels' slab test.
     #[inline(always)]
     fn hits<const W: usize>(&self, l: L, node: &WideNode<W>, c: usize) -> u32 {
-        let slab = |row: usize, a: usize| l.mul(l.sub(l.splat(node.bounds[row][c]), self.o[a]), self.inv[a]);
-        let (lo, hi) = ([slab(0, 0), slab(1, 1), slab(2, 2)], [slab(3, 0), slab(4, 1), slab(5, 2)]);
-        let near = |a: usize| l.select(self.neg[a], hi[a], lo[a]);
-        let far = |a: usize| l.select(self.neg[a], lo[a], hi[a]);
-        let t_near = l.max(near(0), l.max(near(1), l.max(near(2), self.t_min)));
-        let t_far = l.min(far(0), l.min(far(1), l.min(far(2), self.t_max)));
+        // No closures here: a closure is compiled apart from the `#[target_feature]` caller,
+        // and its intrinsics become calls.
+        let mut near = [l.splat(0.0); 3];
+        let mut far = [l.splat(0.0); 3];
+        for a in 0..3 {
+            let lo = l.mul(l.sub(l.splat(node.bounds[a][c]), self.o[a]), self.inv[a]);
+            let hi = l.mul(l.sub(l.splat(node.bounds[3 + a][c]), self.o[a]), self.inv[a]);
+            near[a] = l.select(self.neg[a], hi, lo);
+            far[a] = l.select(self.neg[a], lo, hi);
+        }
+        let t_near = l.max(near[0], l.max(near[1], l.max(near[2], self.t_min)));
+        let t_far = l.min(far[0], l.min(far[1], l.min(far[2], self.t_max)));
         l.bits(l.le(t_near, l.mul(t_far, l.splat(FAR_SCALE))))
     }
 }
@@ -116,11 +123,6 @@ impl<const W: usize> WideBvh<W> {
         let packet = PacketRays::<L>::new(l, nrs, rays);
         let all = u32::MAX >> (32 - n);
         let mut blocked = 0u32;
-        // Tests lane `i`'s ray against a leaf, through the single-ray leaf test.
-        let test_leaf = |i: usize, child: u32| {
-            let (first, count) = leaf_range(child);
-            leaf.single(i).test(first, count, &rays[i])
-        };
         let nodes: &[WideNode<W>] = self.nodes();
         let mut stack: [MaybeUninit<(u32, u32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut sp = 0usize;
@@ -130,7 +132,7 @@ impl<const W: usize> WideBvh<W> {
                 // Only the root is reached as a leaf (leaf children are tested in their
                 // parent); untraceable rays skip it as the single-ray traversal does.
                 for i in lanes(active) {
-                    if !nrs[i].t_min.is_nan() && test_leaf(i, cur) {
+                    if !nrs[i].t_min.is_nan() && test_leaf(leaf, i, cur, rays) {
                         blocked |= 1 << i;
                     }
                 }
@@ -161,7 +163,7 @@ impl<const W: usize> WideBvh<W> {
                 // Leaves first, as the single-ray traversal does: a hit may end lanes.
                 for c in lanes(leaf_bits) {
                     for i in lanes(passed[c] & !blocked) {
-                        if test_leaf(i, node.children[c]) {
+                        if test_leaf(leaf, i, node.children[c], rays) {
                             blocked |= 1 << i;
                         }
                     }
@@ -207,14 +209,30 @@ impl<const W: usize> WideBvh<W> {
     }
 }
 
+/// Lane `i`'s ray against the leaf `child`, through the single-ray leaf test.
+#[inline(always)]
+fn test_leaf<P: PacketLeaf>(leaf: &P, i: usize, child: u32, rays: &[Ray]) -> bool {
+    let (first, count) = leaf_range(child);
+    leaf.single(i).test(first, count, &rays[i])
+}
+
 /// The set bits of `mask`, lowest first.
 #[inline(always)]
-fn lanes(mut mask: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (mask != 0).then(|| {
-            let i = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            i
-        })
-    })
+fn lanes(mask: u32) -> Bits {
+    Bits(mask)
+}
+
+struct Bits(u32);
+
+impl Iterator for Bits {
+    type Item = usize;
+    #[inline(always)]
+    fn next(&mut self) -> Option<usize> {
+        if self.0 == 0 {
+            return None;
+        }
+        let i = self.0.trailing_zeros() as usize;
+        self.0 &= self.0 - 1;
+        Some(i)
+    }
 }

@@ -127,6 +127,17 @@ impl TopLevelBvh {
         }
     }
 
+    /// [`TopLevelBvh::occluded_flat`] of many rays, in packets (`TriangleWideBvh::occluded_packets`).
+    ///
+    /// Panics if the slices differ in length.
+    pub fn occluded_flat_packets(&self, rays: &[Ray], blocked: &mut [bool]) {
+        assert_eq!(rays.len(), blocked.len(), "occluded_flat_packets: one answer per ray");
+        match &self.flat {
+            Some(flat) => flat.occluded_packets(rays, blocked, SimdPath::detect()),
+            None => blocked.fill(false),
+        }
+    }
+
     /// [`TopLevelBvh::occluded_flat`] of many rays at once.
     ///
     /// Panics if the slices differ in length.

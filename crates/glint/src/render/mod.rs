@@ -52,15 +52,33 @@ pub enum Schedule {
     /// As `Wavefront`, the batches traced by the interleaved batch traversal (several rays in
     /// flight per thread): 3 to 5% slower than `Wavefront` on Zen 5 (BENCHMARKS.md).
     WavefrontInterleaved,
+    /// As `Wavefront`, the shadow rays traced in packets (8 or 16 rays per instruction,
+    /// `accel::packet`).
+    WavefrontPackets,
 }
 
 impl Schedule {
+    /// Every schedule (the tests render each and compare the bits).
+    pub const ALL: [Schedule; 4] =
+        [Schedule::OnePath, Schedule::Wavefront, Schedule::WavefrontInterleaved, Schedule::WavefrontPackets];
+
     /// How the wavefront schedules trace their batches (`None`: one path at a time).
     pub fn batch_traversal(self) -> Option<BatchTraversal> {
         match self {
             Schedule::OnePath => None,
             Schedule::Wavefront => Some(BatchTraversal::OneByOne),
             Schedule::WavefrontInterleaved => Some(BatchTraversal::Interleaved),
+            Schedule::WavefrontPackets => Some(BatchTraversal::Packets),
+        }
+    }
+
+    /// The name on the command line and in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Schedule::OnePath => "one-path",
+            Schedule::Wavefront => "wavefront",
+            Schedule::WavefrontInterleaved => "wavefront-interleaved",
+            Schedule::WavefrontPackets => "wavefront-packets",
         }
     }
 }
@@ -68,12 +86,10 @@ impl Schedule {
 impl std::str::FromStr for Schedule {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "one-path" => Ok(Schedule::OnePath),
-            "wavefront" => Ok(Schedule::Wavefront),
-            "wavefront-interleaved" => Ok(Schedule::WavefrontInterleaved),
-            _ => Err(format!("unknown schedule '{s}' (expected wavefront, wavefront-interleaved or one-path)")),
-        }
+        Schedule::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Schedule::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown schedule '{s}' (expected {})", names.join(", "))
+        })
     }
 }
 

@@ -49,6 +49,8 @@ pub enum BatchTraversal {
     OneByOne,
     /// Several traversals in flight per thread, interleaved ([`World::intersect_batch`]).
     Interleaved,
+    /// Closest hits one by one, occlusion in packets of rays ([`World::occluded_packets`]).
+    Packets,
 }
 
 /// Mesh data (positions, normals, uvs, indices) above which the wavefront prefetches hit
@@ -349,7 +351,7 @@ impl World {
     pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>], traversal: BatchTraversal) {
         match traversal {
             BatchTraversal::Interleaved => self.intersect_batch(rays, hits),
-            BatchTraversal::OneByOne => {
+            BatchTraversal::OneByOne | BatchTraversal::Packets => {
                 assert_eq!(rays.len(), hits.len(), "intersect_many: one hit slot per ray");
                 for (r, h) in rays.iter().zip(hits.iter_mut()) {
                     *h = self.intersect(r);
@@ -362,12 +364,25 @@ impl World {
     pub fn occluded_many(&self, rays: &[Ray], blocked: &mut [bool], traversal: BatchTraversal) {
         match traversal {
             BatchTraversal::Interleaved => self.occluded_batch(rays, blocked),
+            BatchTraversal::Packets => self.occluded_packets(rays, blocked),
             BatchTraversal::OneByOne => {
                 assert_eq!(rays.len(), blocked.len(), "occluded_many: one answer per ray");
                 for (r, b) in rays.iter().zip(blocked.iter_mut()) {
                     *b = self.occluded(r);
                 }
             }
+        }
+    }
+
+    /// Whether each ray is blocked, the flat BVH traced in packets of rays: `blocked[i]` is
+    /// [`World::occluded`] of `rays[i]`.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn occluded_packets(&self, rays: &[Ray], blocked: &mut [bool]) {
+        assert_eq!(rays.len(), blocked.len(), "occluded_packets: one answer per ray");
+        self.top.occluded_flat_packets(rays, blocked);
+        for (ray, b) in rays.iter().zip(blocked.iter_mut()) {
+            *b = *b || self.occluded_unflattened(ray);
         }
     }
 

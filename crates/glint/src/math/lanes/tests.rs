@@ -34,6 +34,11 @@ fn value(rng: &mut Rng) -> f32 {
     }
 }
 
+/// An operation's name, its result on the lanes, and the one-lane operation it must match.
+type Unary<'a, F> = (&'a str, F, fn(f32) -> f32);
+type Binary<'a, F> = (&'a str, F, fn(f32, f32) -> f32);
+type Predicate<'a, M> = (&'a str, M, fn(f32, f32) -> bool);
+
 fn check<L: Lanes>(l: L, name: &str) {
     let n = L::N;
     let mut rng = Rng::new(17, n as u64);
@@ -44,8 +49,8 @@ fn check<L: Lanes>(l: L, name: &str) {
         // and the comparisons.
         let b: Vec<f32> = (0..n).map(|i| if round % 2 == 0 && i % 3 == 0 { a[i] } else { value(&mut rng) }).collect();
         let (va, vb) = (l.load(&a), l.load(&b));
-        let unary: [(&str, L::F, fn(f32) -> f32); 1] = [("sqrt", l.sqrt(va), |x| One.sqrt(x))];
-        let binary: [(&str, L::F, fn(f32, f32) -> f32); 6] = [
+        let unary: [Unary<L::F>; 1] = [("sqrt", l.sqrt(va), |x| One.sqrt(x))];
+        let binary: [Binary<L::F>; 6] = [
             ("add", l.add(va, vb), |x, y| One.add(x, y)),
             ("sub", l.sub(va, vb), |x, y| One.sub(x, y)),
             ("mul", l.mul(va, vb), |x, y| One.mul(x, y)),
@@ -65,7 +70,7 @@ fn check<L: Lanes>(l: L, name: &str) {
                 assert_eq!(out[i].to_bits(), f(a[i], b[i]).to_bits(), "{name} {op}({:?}, {:?}) lane {i}", a[i], b[i]);
             }
         }
-        let masks: [(&str, L::M, fn(f32, f32) -> bool); 7] = [
+        let masks: [Predicate<L::M>; 7] = [
             ("lt", l.lt(va, vb), |x, y| One.lt(x, y)),
             ("le", l.le(va, vb), |x, y| One.le(x, y)),
             ("gt", l.gt(va, vb), |x, y| One.gt(x, y)),
