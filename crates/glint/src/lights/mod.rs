@@ -875,7 +875,7 @@ mod tests {
         assert!(importance(&light(m, hot_bitmap())).is_none());
         // A rim vertex pulled off the ellipse.
         let mut m = disk_mesh(BvhSplit::Sah);
-        m.positions[7] = m.positions[7] * 0.9;
+        m.positions[7] *= 0.9;
         assert!(importance(&light(m, hot_bitmap())).is_none());
         // The rectangle keeps its own.
         let quad = crate::geometry::rectangle_mesh(BvhSplit::Sah);

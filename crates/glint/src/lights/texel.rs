@@ -324,7 +324,7 @@ impl UvDisk {
     /// centre at those azimuths (within 1e-4 of its axes' length), N a multiple of 4.
     pub fn new(centre: Vec3, edges: Vec<[Vec3; 2]>) -> Option<UvDisk> {
         let n = edges.len();
-        if n < 4 || n % 4 != 0 {
+        if n < 4 || !n.is_multiple_of(4) {
             return None;
         }
         let (ax, ay) = (edges[0][0] - centre, edges[n / 4][0] - centre);
@@ -518,7 +518,7 @@ mod tests {
         assert!((mapped / fan_area - 1.0).abs() < 1e-5, "{mapped} vs {fan_area}");
         // A rim off the ellipse is not a disk.
         let mut bent = edges;
-        bent[3][1] = bent[3][1] + ax * 0.01;
+        bent[3][1] += ax * 0.01;
         assert!(UvDisk::new(centre, bent).is_none());
     }
 
