@@ -6,14 +6,16 @@
 //! - `power()`: an estimate of emitted flux, for choosing among lights.
 //!
 //! Area lights emit a radiance texture read at the surface's uv (Mitsuba's `area` emitter
-//! with a textured `radiance`). A bitmap radiance on a sphere, a cylinder or a rectangle
-//! whose uvs span it once is sampled by its texels (`texel`: the filtered luminance times
-//! the area Jacobian, mapped onto the surface), as Mitsuba samples it; other textures and
-//! other meshes (disks, general meshes with uvs) are sampled by the shape's geometry alone
-//! (by solid angle where the shape allows it, by area otherwise) and the texture is read at
-//! the point sampled. Either way `pdf_li` gives the density the sampler used, so light
-//! sampling and rays that hit the light are weighed alike. Their power (for light
-//! selection) uses the texture's mean.
+//! with a textured `radiance`). A bitmap radiance on a sphere, a cylinder, a rectangle whose
+//! uvs span it once, or a disk (the fan of triangles `geometry::disk_mesh` makes, with its
+//! polar uvs, told by `MeshEmitter::uv_disk`) is sampled by its texels (`texel`: the
+//! filtered luminance times the area Jacobian, mapped onto the surface: on the disk the
+//! Jacobian, u, enters exactly, so the density per unit area is the luminance itself), as
+//! Mitsuba samples it by its texels in uv; other textures and other meshes (general meshes
+//! with uvs) are sampled by the shape's geometry alone (by solid angle where the shape
+//! allows it, by area otherwise) and the texture is read at the point sampled. Either way
+//! `pdf_li` gives the density the sampler used, so light sampling and rays that hit the
+//! light are weighed alike. Their power (for light selection) uses the texture's mean.
 //!
 //! Delta lights (point, spot, directional) have a density of 1 by convention and are never
 //! hit by BSDF-sampled rays.
