@@ -9,7 +9,10 @@
 //!
 //! Cases: spheres seen from outside (cone sampling), near and far; rectangles near enough
 //! to be sampled by solid angle, and one so far that it is sampled by area; a rectangle
-//! emitting a high-contrast bitmap, sampled by its texels.
+//! emitting a high-contrast bitmap, sampled by its texels; a disk (the fan of triangles
+//! every disk is made as, turned, squashed into an ellipse and with its normals flipped)
+//! emitting the same bitmap over its polar uvs, sampled by its texels, in solid angle and
+//! again in its uv square.
 //!
 //! A sphere and a cylinder emitting a bitmap are sampled by its texels over their whole
 //! surface (samples on the far side are refused), with a density in solid angle that grows
@@ -22,8 +25,8 @@ mod common;
 use common::bsdf_check::chi2_test;
 use common::stats::{sidak, FALSE_ALARM};
 use glint::accel::BvhSplit;
-use glint::geometry::{quad_mesh, Cylinder, Sphere};
-use glint::lights::{Light, MeshEmitter};
+use glint::geometry::{disk_mesh, quad_mesh, Cylinder, Sphere, DISK_SEGMENTS};
+use glint::lights::{Light, MeshEmitter, MeshImportance};
 use glint::materials::{Bitmap, Texture};
 use glint::math::Transform;
 use glint::math::{rgb, vec3, Frame, Ray, Rgb, Vec3};
@@ -142,9 +145,113 @@ fn textured_rectangle_case(p: Vec3) -> Case {
     Case { label: "textured rectangle", light, p, axis, extent: extent_of(quad.into_iter(), p, axis), hit }
 }
 
+/// The disk of `textured_disk`, written out here independently of the light's own map: the
+/// unit disk's fan of `DISK_SEGMENTS` triangles scaled to 0.6 × 0.4, turned to lie in the
+/// plane y = 1 facing up and, by flipped normals, emitting downwards. Local (x, y) is world
+/// (x / 0.6, -z / 0.4); the azimuth runs from +x towards -z.
+struct DiskGeometry;
+
+impl DiskGeometry {
+    const HALF: [f32; 2] = [0.6, 0.4];
+
+    fn transform() -> Transform {
+        // (x, y, 0) goes to (0.6 x, 1, -0.4 y), as `textured_disk` checks.
+        Transform::translate(vec3(0.0, 1.0, 0.0))
+            .then_after(&Transform::rotate(Vec3::X, -90.0))
+            .then_after(&Transform::scale(vec3(Self::HALF[0], Self::HALF[1], 1.0)).unwrap())
+    }
+
+    fn local(q: Vec3) -> (f32, f32) {
+        (q.x / Self::HALF[0], -q.z / Self::HALF[1])
+    }
+
+    fn world(x: f32, y: f32) -> Vec3 {
+        vec3(x * Self::HALF[0], 1.0, -y * Self::HALF[1])
+    }
+
+    /// The polygon's point at polar uv (u, v): segment k = ⌊vN⌋, the point t = vN - k along
+    /// its rim edge, scaled by u from the centre; with the area per unit uv, u N |e0 × e1|.
+    fn at(uv: [f32; 2]) -> (Vec3, f32) {
+        let n = DISK_SEGMENTS as f32;
+        let k = (uv[1] * n).floor().min(n - 1.0);
+        let t = uv[1] * n - k;
+        let rim = |j: f32| {
+            let phi = 2.0 * std::f32::consts::PI * j / n;
+            (phi.cos(), phi.sin())
+        };
+        let ((x0, y0), (x1, y1)) = (rim(k), rim(k + 1.0));
+        let jacobian = n * (x0 * y1 - x1 * y0) * Self::HALF[0] * Self::HALF[1];
+        (Self::world(uv[0] * (x0 + t * (x1 - x0)), uv[0] * (y0 + t * (y1 - y0))), uv[0] * jacobian)
+    }
+
+    /// The polar uv of a point of the polygon.
+    fn uv(q: Vec3) -> [f32; 2] {
+        let n = DISK_SEGMENTS as f32;
+        let (x, y) = Self::local(q);
+        let turn = y.atan2(x) / (2.0 * std::f32::consts::PI);
+        let turn = if turn < 0.0 { turn + 1.0 } else { turn };
+        let k = (turn * n).floor().min(n - 1.0);
+        // Solve (x, y) = u ((1 - t) r_k + t r_k+1).
+        let rim = |j: f32| {
+            let phi = 2.0 * std::f32::consts::PI * j / n;
+            (phi.cos(), phi.sin())
+        };
+        let ((x0, y0), (x1, y1)) = (rim(k), rim(k + 1.0));
+        let det = x0 * y1 - x1 * y0;
+        let (a, b) = ((x * y1 - y * x1) / det, (x0 * y - y0 * x) / det);
+        let u = a + b;
+        let t = if u > 0.0 { b / u } else { 0.5 };
+        [u, (k + t.clamp(0.0, 1.0)) / n]
+    }
+
+    /// Whether a point of the plane is on the polygon.
+    fn inside(q: Vec3) -> bool {
+        let [u, _] = Self::uv(q);
+        u <= 1.0
+    }
+}
+
+fn textured_disk() -> Light {
+    let xf = DiskGeometry::transform();
+    let mesh = Arc::new(disk_mesh(BvhSplit::Sah));
+    // What the builder hands the light: world-space triangles, corners 1 and 2 swapped for the
+    // flipped normals, and the mesh for its uvs.
+    let tris = (0..mesh.indices.len())
+        .map(|t| mesh.vertices(t).map(|v| xf.point(v)))
+        .map(|[a, b, c]| [a, c, b])
+        .collect::<Vec<_>>();
+    let [a, b, c] = tris[0];
+    assert!((b - a).cross(c - a).y < 0.0, "the disk does not face down");
+    for (x, y) in [(1.0, 0.0), (0.0, 1.0)] {
+        assert!((xf.point(vec3(x, y, 0.0)) - DiskGeometry::world(x, y)).length() < 1e-6);
+    }
+    let emitter = MeshEmitter::of_mesh(tris, mesh, true).unwrap();
+    let light = Light::mesh(0, Arc::new(emitter), contrast_bitmap(), false);
+    assert!(
+        matches!(&light, Light::Mesh { importance: Some(i), .. } if matches!(**i, MeshImportance::Disk(_))),
+        "not sampled by its texels"
+    );
+    light
+}
+
+fn textured_disk_case(p: Vec3) -> Case {
+    let hit: Hit = Box::new(move |o, w| {
+        let t = (1.0 - o.y) / w.y;
+        let q = o + w * t;
+        (t > 0.0 && DiskGeometry::inside(q)).then_some((q, vec3(0.0, -1.0, 0.0)))
+    });
+    let axis = (vec3(0.0, 1.0, 0.0) - p).normalize();
+    let rim = (0..64).map(|k| {
+        let phi = 2.0 * std::f32::consts::PI * k as f32 / 64.0;
+        DiskGeometry::world(phi.cos(), phi.sin())
+    });
+    Case { label: "textured disk", light: textured_disk(), p, axis, extent: extent_of(rim, p, axis), hit }
+}
+
 fn cases() -> Vec<Case> {
     vec![
         textured_rectangle_case(vec3(0.1, 0.2, 0.05)),
+        textured_disk_case(vec3(0.15, 0.3, -0.1)),
         sphere_case("sphere at 3 radii", vec3(0.3, 3.0, -0.2), 1.0, Vec3::ZERO),
         sphere_case("sphere filling 110 degrees", vec3(0.0, 0.0, 0.6), 0.5, Vec3::ZERO),
         sphere_case("small distant sphere", vec3(40.0, 10.0, 5.0), 0.2, vec3(0.1, 0.2, 0.3)),
@@ -322,6 +429,16 @@ fn curved_cases() -> Vec<CurvedCase> {
                 (q.p, q.n, c.area())
             }),
             uv_of: Box::new(move |q| c.uv_at(q)),
+        },
+        CurvedCase {
+            label: "textured disk",
+            light: textured_disk(),
+            p: vec3(-0.2, 0.4, 0.1),
+            surface: Box::new(|uv| {
+                let (q, jacobian) = DiskGeometry::at(uv);
+                (q, vec3(0.0, -1.0, 0.0), jacobian)
+            }),
+            uv_of: Box::new(DiskGeometry::uv),
         },
     ]
 }

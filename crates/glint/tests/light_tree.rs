@@ -19,7 +19,7 @@ use glint::accel::BvhSplit;
 use glint::assemble::WorldBuilder;
 use glint::integrators::{DirectSettings, Integrator};
 use glint::lights::{by_triangle, AreaEmission, Light, LightSelection};
-use glint::materials::Texture;
+use glint::materials::{Bitmap, Texture};
 use glint::math::{rgb, vec3, Frame, Rgb, Transform, Vec3};
 use glint::sampling::Rng;
 use glint::world::World;
@@ -125,8 +125,8 @@ fn many_lights(sky: bool, deltas: bool) -> World {
     b.finish(cam, LightSelection::Tree).unwrap()
 }
 
-/// `LightSelection::Auto` is the tree on a textured emitting mesh and with many lights, and
-/// power otherwise.
+/// `LightSelection::Auto` is the tree on a textured emitting mesh split by triangle and with
+/// many lights, and power otherwise.
 #[test]
 fn auto_selection_is_the_tree_where_it_has_something_to_choose_by() {
     let disk = std::sync::Arc::new(glint::geometry::disk_mesh(BvhSplit::Sah));
@@ -160,6 +160,13 @@ fn auto_selection_is_the_tree_where_it_has_something_to_choose_by() {
                     let emission = Some(AreaEmission { radiance, two_sided: false });
                     b.add_mesh_instance(&disk, &at, false, lamp, emission, false).unwrap();
                 }
+                "bitmap disk" => {
+                    let pixels = (0..8).map(|k| Rgb::splat(if k == 5 { 30.0 } else { 0.5 })).collect();
+                    let image = std::sync::Arc::new(Bitmap { width: 4, height: 2, pixels });
+                    let radiance = Texture::Bitmap { image, uv_scale: [1.0, 1.0], uv_offset: [0.0, 0.0] };
+                    let emission = Some(AreaEmission { radiance, two_sided: false });
+                    b.add_mesh_instance(&disk, &at, false, lamp, emission, false).unwrap();
+                }
                 "sky" => b.add_constant_environment(Rgb::splat(0.1)),
                 other => panic!("no such light {other}"),
             }
@@ -174,6 +181,8 @@ fn auto_selection_is_the_tree_where_it_has_something_to_choose_by() {
     assert_eq!(world(&many), LightSelection::Tree);
     assert_eq!(world(&many[1..]), LightSelection::Power);
     assert_eq!(world(&["textured disk"]), LightSelection::Tree);
+    // A bitmap on a disk is sampled by its texels, the disk one leaf: nothing to choose by.
+    assert_eq!(world(&["bitmap disk"]), LightSelection::Power);
 }
 
 #[test]

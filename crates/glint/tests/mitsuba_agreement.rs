@@ -360,6 +360,14 @@ fn large_light_of_a_few_bright_texels() {
     check_against("area-bright-texels", 0.01, 1.0);
 }
 
+/// A disk light whose bitmap is a few bright texels on a dim ground, read at the disk's polar
+/// uv: sampled by its texels times the disk's area Jacobian and mapped onto the disk (glint's
+/// disk is a fan of triangles; Mitsuba's is exact), at most 1.0x Mitsuba's error.
+#[test]
+fn disk_light_of_a_few_bright_texels() {
+    check_against("area-textured-disk", 0.01, 1.0);
+}
+
 /// Curves and the hair BSDF: a fur ball of B-spline curves with pigmented hair and the same
 /// curves, smaller, as linear curves with an absorption coefficient and rough scales, under
 /// an environment map and a sphere light.

@@ -49,7 +49,8 @@ pub enum LightSelection {
     /// of lights sends there (`lights::LightTree`).
     Tree,
     /// `Tree` where it was measured to win (`World::AUTO_TREE_LIGHTS` or more bounded lights,
-    /// or a mesh light whose radiance varies over its triangles), else `Power`. Not the
+    /// or a mesh light whose radiance varies over the triangles it is split into: not a
+    /// rectangle or a disk sampled by its texels, which is one leaf), else `Power`. Not the
     /// default: with a few lights the tree's error was higher than power's on 8 of 9 of
     /// Mitsuba's documentation scenes it would change (BENCHMARKS.md, "Light selection").
     Auto,

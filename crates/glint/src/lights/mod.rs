@@ -6,14 +6,16 @@
 //! - `power()`: an estimate of emitted flux, for choosing among lights.
 //!
 //! Area lights emit a radiance texture read at the surface's uv (Mitsuba's `area` emitter
-//! with a textured `radiance`). A bitmap radiance on a sphere, a cylinder or a rectangle
-//! whose uvs span it once is sampled by its texels (`texel`: the filtered luminance times
-//! the area Jacobian, mapped onto the surface), as Mitsuba samples it; other textures and
-//! other meshes (disks, general meshes with uvs) are sampled by the shape's geometry alone
-//! (by solid angle where the shape allows it, by area otherwise) and the texture is read at
-//! the point sampled. Either way `pdf_li` gives the density the sampler used, so light
-//! sampling and rays that hit the light are weighed alike. Their power (for light
-//! selection) uses the texture's mean.
+//! with a textured `radiance`). A bitmap radiance on a sphere, a cylinder, a rectangle whose
+//! uvs span it once, or a disk (the fan of triangles `geometry::disk_mesh` makes, with its
+//! polar uvs, told by `MeshEmitter::uv_disk`) is sampled by its texels (`texel`: the
+//! filtered luminance times the area Jacobian, mapped onto the surface: on the disk the
+//! Jacobian, u, enters exactly, so the density per unit area is the luminance itself), as
+//! Mitsuba samples it by its texels in uv; other textures and other meshes (general meshes
+//! with uvs) are sampled by the shape's geometry alone (by solid angle where the shape
+//! allows it, by area otherwise) and the texture is read at the point sampled. Either way
+//! `pdf_li` gives the density the sampler used, so light sampling and rays that hit the
+//! light are weighed alike. Their power (for light selection) uses the texture's mean.
 //!
 //! Delta lights (point, spot, directional) have a density of 1 by convention and are never
 //! hit by BSDF-sampled rays.
@@ -28,7 +30,7 @@ pub use crate::describe::LightSelection;
 pub use envmap::EnvMap;
 pub use projected::{ProjectedKind, ProjectedLight};
 pub use rectangle::Rectangle;
-pub use texel::{RectangleImportance, TexelImportance, UvJacobian, UvRectangle};
+pub use texel::{DiskImportance, RectangleImportance, TexelImportance, UvDisk, UvJacobian, UvRectangle};
 pub use tree::{by_triangle, LightTree, TreeSample};
 
 use rectangle::SphericalRectangle;
@@ -190,6 +192,36 @@ impl MeshEmitter {
         (same_map && onto).then_some(map)
     }
 
+    /// The uv map of a disk emitter made as `geometry::disk_mesh` makes it (under any affine
+    /// map, normals flipped or not), for importance-sampling a bitmap on it; `None` for other
+    /// meshes. What is checked is what the map relies on: triangle k is the centre and rim
+    /// vertices k and k + 1 with the polar uvs (0, (k + ½)/N), (1, k/N), (1, (k + 1)/N), and
+    /// the rim lies on an ellipse at those azimuths.
+    pub fn uv_disk(&self) -> Option<UvDisk> {
+        let mesh = self.mesh.as_deref()?;
+        let uvs = mesh.uvs.as_ref()?;
+        let n = self.triangles.len();
+        if n < 4 || mesh.indices.len() != n {
+            return None;
+        }
+        let centre = self.triangles[0][0];
+        let tol = 1e-4 * (self.triangles[0][1] - centre).length();
+        let mut edges = Vec::with_capacity(n);
+        for (k, (tri, idx)) in self.triangles.iter().zip(&mesh.indices).enumerate() {
+            let expected =
+                [[0.0, (k as f32 + 0.5) / n as f32], [1.0, k as f32 / n as f32], [1.0, (k + 1) as f32 / n as f32]];
+            let same_uv = |i: u32, e: [f32; 2]| {
+                uvs.get(i as usize).is_some_and(|t| (t[0] - e[0]).abs() <= 1e-6 && (t[1] - e[1]).abs() <= 1e-6)
+            };
+            if !(0..3).all(|c| same_uv(idx[c], expected[c])) || !((tri[0] - centre).length() <= tol) {
+                return None;
+            }
+            // The emitter's corners 1 and 2 are the mesh's 2 and 1 when the normals are flipped.
+            edges.push(if self.flipped { [tri[2], tri[1]] } else { [tri[1], tri[2]] });
+        }
+        UvDisk::new(centre, edges)
+    }
+
     /// Whether light samples seen from `p` are drawn by solid angle (otherwise by area).
     pub fn samples_by_solid_angle(&self, p: Vec3) -> bool {
         self.spherical_rectangle(p).is_some()
@@ -199,6 +231,14 @@ impl MeshEmitter {
     fn spherical_rectangle(&self, p: Vec3) -> Option<SphericalRectangle> {
         self.rectangle.as_ref().and_then(|r| SphericalRectangle::new(r, p))
     }
+}
+
+/// How a mesh light's bitmap radiance is sampled by its texels: over a rectangle whose uvs
+/// are affine, or over a disk's polar uvs.
+#[derive(Clone, Debug)]
+pub enum MeshImportance {
+    Rectangle(RectangleImportance),
+    Disk(DiskImportance),
 }
 
 #[derive(Clone, Debug)]
@@ -232,8 +272,8 @@ pub enum Light {
         emitter: Arc<MeshEmitter>,
         radiance: Texture,
         two_sided: bool,
-        /// A bitmap radiance on a rectangle, sampled by its texels (see `texel`).
-        importance: Option<Arc<RectangleImportance>>,
+        /// A bitmap radiance on a rectangle or a disk, sampled by its texels (see `texel`).
+        importance: Option<Arc<MeshImportance>>,
     },
     /// Area light on a sphere; sampled by the solid angle it subtends.
     Sphere {
@@ -267,14 +307,20 @@ pub enum Light {
 }
 
 impl Light {
-    /// An area light on a mesh; a bitmap radiance on a rectangle whose uvs span it once is
-    /// importance-sampled by its texels.
+    /// An area light on a mesh; a bitmap radiance on a rectangle whose uvs span it once, or
+    /// on a disk with its polar uvs, is importance-sampled by its texels.
     pub fn mesh(instance: u32, emitter: Arc<MeshEmitter>, radiance: Texture, two_sided: bool) -> Light {
-        let importance = emitter.uv_rectangle().and_then(|map| {
-            let texels = TexelImportance::new(&radiance, UvJacobian::Uniform)?;
-            Some(Arc::new(RectangleImportance { texels, map }))
-        });
-        Light::Mesh { instance, emitter, radiance, two_sided, importance }
+        let importance = match emitter.uv_rectangle() {
+            Some(map) => TexelImportance::new(&radiance, UvJacobian::Uniform)
+                .map(|texels| MeshImportance::Rectangle(RectangleImportance { texels, map })),
+            // Only a bitmap can be sampled by its texels: other meshes are not looked at.
+            None if matches!(radiance, Texture::Bitmap { .. }) => emitter.uv_disk().and_then(|map| {
+                let texels = TexelImportance::new(&radiance, UvJacobian::LinearU)?;
+                Some(MeshImportance::Disk(DiskImportance { texels, map }))
+            }),
+            None => None,
+        };
+        Light::Mesh { instance, emitter, radiance, two_sided, importance: importance.map(Arc::new) }
     }
 
     /// An area light on a sphere; a bitmap radiance is importance-sampled by its texels.
@@ -367,12 +413,26 @@ impl Light {
             Light::Directional { direction, irradiance, .. } => {
                 Some(LightSample { wi: -*direction, radiance: *irradiance, pdf: 1.0, dist: f32::INFINITY, delta: true })
             }
-            Light::Mesh { emitter, radiance, two_sided, importance: Some(imp), .. } => {
-                let (uv, pdf_uv) = imp.texels.sample(u)?;
-                let n = emitter.rectangle.as_ref()?.normal;
-                let le = radiance_at(radiance, || TexturePoint::uv(uv));
-                area_sample(p, imp.map.point(uv), n, *two_sided, pdf_uv / imp.map.area, le)
-            }
+            Light::Mesh { emitter, radiance, two_sided, importance: Some(imp), .. } => match &**imp {
+                MeshImportance::Rectangle(imp) => {
+                    let (uv, pdf_uv) = imp.texels.sample(u)?;
+                    let n = emitter.rectangle.as_ref()?.normal;
+                    let le = radiance_at(radiance, || TexturePoint::uv(uv));
+                    area_sample(p, imp.map.point(uv), n, *two_sided, pdf_uv / imp.map.area, le)
+                }
+                MeshImportance::Disk(imp) => {
+                    let (uv, pdf_uv) = imp.texels.sample(u)?;
+                    let (q, k, t) = imp.map.point(uv);
+                    let [a, b, c] = emitter.triangles[k];
+                    let n = (b - a).cross(c - a).normalize();
+                    // Read where a ray hitting q reads it: the mesh's interpolated uv at q's
+                    // barycentrics on triangle k (rim vertex k weighs u(1 - t), k + 1 weighs ut).
+                    let rim = [uv[0] * (1.0 - t), uv[0] * t];
+                    let bary = if emitter.flipped { [rim[1], rim[0]] } else { rim };
+                    let le = radiance_at(radiance, || emitter.texture_point(k, bary));
+                    area_sample(p, q, n, *two_sided, imp.map.area_density(pdf_uv, uv, k), le)
+                }
+            },
             Light::Mesh { emitter, radiance, two_sided, importance: None, .. } => {
                 let by_solid_angle = emitter.spherical_rectangle(p);
                 let (q, n, at) = match &by_solid_angle {
@@ -507,9 +567,15 @@ impl Light {
     /// area light, or direction `wi` for an infinite light.
     pub fn pdf_li(&self, p: Vec3, wi: Vec3, q: Vec3, n: Vec3) -> f32 {
         match self {
-            Light::Mesh { importance: Some(imp), .. } => {
-                solid_angle_pdf(p, wi, q, n, imp.texels.pdf(imp.map.uv(q)) / imp.map.area)
-            }
+            Light::Mesh { importance: Some(imp), .. } => match &**imp {
+                MeshImportance::Rectangle(imp) => {
+                    solid_angle_pdf(p, wi, q, n, imp.texels.pdf(imp.map.uv(q)) / imp.map.area)
+                }
+                MeshImportance::Disk(imp) => {
+                    let (uv, k, _) = imp.map.uv(q);
+                    solid_angle_pdf(p, wi, q, n, imp.map.area_density(imp.texels.pdf(uv), uv, k))
+                }
+            },
             Light::Sphere { sphere, importance: Some(imp), .. } => {
                 let dir = (q - sphere.center).normalize();
                 let st = (1.0 - sphere.to_local(dir).z.powi(2)).max(0.0).sqrt();
@@ -709,5 +775,112 @@ mod tests {
             }
         }
         assert_eq!(cells, [[1; 4]; 4]);
+    }
+
+    /// An 8 × 4 bitmap with a hot texel, so that the density varies 100× over the disk.
+    fn hot_bitmap() -> Texture {
+        let pixels = (0..32).map(|k| {
+            if k == 13 {
+                crate::math::rgb(90.0, 60.0, 30.0)
+            } else {
+                Rgb::splat(0.3 + 0.1 * (k % 3) as f32)
+            }
+        });
+        Texture::Bitmap {
+            image: Arc::new(crate::materials::Bitmap { width: 8, height: 4, pixels: pixels.collect() }),
+            uv_scale: [1.0; 2],
+            uv_offset: [0.0; 2],
+        }
+    }
+
+    /// The unit disk's fan placed by `xf`, as the builder hands it to a light.
+    fn disk_emitter(mesh: TriangleMesh, xf: &crate::math::Transform, flipped: bool) -> MeshEmitter {
+        let tris = (0..mesh.indices.len())
+            .map(|t| mesh.vertices(t).map(|v| xf.point(v)))
+            .map(|[a, b, c]| if flipped { [a, c, b] } else { [a, b, c] })
+            .collect();
+        MeshEmitter::of_mesh(tris, Arc::new(mesh), flipped).unwrap()
+    }
+
+    fn placed() -> crate::math::Transform {
+        use crate::math::Transform;
+        Transform::translate(vec3(0.3, 1.5, -0.2))
+            .then_after(&Transform::rotate(vec3(1.0, 0.2, 0.0).normalize(), 100.0))
+            .then_after(&Transform::scale(vec3(0.7, 0.4, 1.0)).unwrap())
+    }
+
+    fn importance_of(l: &Light) -> Option<&MeshImportance> {
+        match l {
+            Light::Mesh { importance, .. } => importance.as_deref(),
+            _ => None,
+        }
+    }
+
+    #[test]
+    fn bitmaps_on_disks_are_sampled_by_their_texels_at_the_density_pdf_li_gives() {
+        // From points on both sides of a turned, squashed disk, one- and two-sided, normals
+        // flipped or not: every sample's density is what pdf_li gives the same point, and its
+        // radiance is the texture read where a ray hitting that point reads it.
+        use crate::accel::BvhSplit;
+        use crate::geometry::disk_mesh;
+        let xf = placed();
+        let mut rng = crate::sampling::Rng::new(17, 3);
+        let mut checked = 0;
+        for (flipped, two_sided) in [(false, false), (true, false), (false, true)] {
+            let emitter = Arc::new(disk_emitter(disk_mesh(BvhSplit::Sah), &xf, flipped));
+            let light = Light::mesh(0, emitter.clone(), hot_bitmap(), two_sided);
+            assert!(matches!(importance_of(&light), Some(MeshImportance::Disk(_))));
+            let centre = xf.point(Vec3::ZERO);
+            let normal = xf.normal(Vec3::Z).normalize();
+            for side in [1.0, -1.0] {
+                let p = centre + normal * (0.6 * side) + vec3(0.2, -0.1, 0.15);
+                for _ in 0..5000 {
+                    let Some(ls) = light.sample_li(p, [rng.next_f32(), rng.next_f32()]) else { continue };
+                    let q = p + ls.wi * ls.dist;
+                    let pdf = light.pdf_li(p, ls.wi, q, normal);
+                    assert!((pdf / ls.pdf - 1.0).abs() < 1e-3, "{q:?}: pdf_li {pdf} vs the sample's {}", ls.pdf);
+                    // The mesh's uv there: u, and v between the centre's (k + ½)/N and the
+                    // rim's (k + t)/N in proportion to u (barycentrics in these thin
+                    // triangles, as `locate` finds them, are too coarse to check against).
+                    let Some(MeshImportance::Disk(d)) = importance_of(&light) else { unreachable!() };
+                    let ([u, _], k, t) = d.map.uv(q);
+                    let n = emitter.triangles.len() as f32;
+                    let v = (1.0 - u) * (k as f32 + 0.5) / n + u * (k as f32 + t) / n;
+                    let expected = hot_bitmap().eval([u, v]);
+                    let (got, want) =
+                        ([ls.radiance.r, ls.radiance.g, ls.radiance.b], [expected.r, expected.g, expected.b]);
+                    assert!((0..3).all(|c| (got[c] - want[c]).abs() <= 1e-3 * want[c]), "{q:?}: {got:?} vs {want:?}");
+                    checked += 1;
+                }
+            }
+        }
+        // One-sided lights are sampled from their emitting side only.
+        assert!(checked > 5000 * 3, "{checked}");
+    }
+
+    #[test]
+    fn only_bitmaps_on_a_true_disk_fan_are_sampled_by_texels() {
+        use crate::accel::BvhSplit;
+        use crate::geometry::disk_mesh;
+        let xf = placed();
+        let light = |mesh: TriangleMesh, radiance: Texture| {
+            Light::mesh(0, Arc::new(disk_emitter(mesh, &xf, false)), radiance, false)
+        };
+        let importance = |l: &Light| importance_of(l).cloned();
+        let disk = light(disk_mesh(BvhSplit::Sah), hot_bitmap());
+        assert!(matches!(importance(&disk), Some(MeshImportance::Disk(_))));
+        // Not a bitmap.
+        assert!(importance(&light(disk_mesh(BvhSplit::Sah), Texture::Constant(Rgb::WHITE))).is_none());
+        // Uvs that are not the disk's polar ones (one rim vertex's azimuth moved).
+        let mut m = disk_mesh(BvhSplit::Sah);
+        m.uvs.as_mut().unwrap()[4][1] += 0.01;
+        assert!(importance(&light(m, hot_bitmap())).is_none());
+        // A rim vertex pulled off the ellipse.
+        let mut m = disk_mesh(BvhSplit::Sah);
+        m.positions[7] *= 0.9;
+        assert!(importance(&light(m, hot_bitmap())).is_none());
+        // The rectangle keeps its own.
+        let quad = crate::geometry::rectangle_mesh(BvhSplit::Sah);
+        assert!(matches!(importance(&light(quad, hot_bitmap())), Some(MeshImportance::Rectangle(_))));
     }
 }

@@ -182,9 +182,11 @@ fn minus_clamped(cos_a: f32, sin_a: f32, cos_b: f32, sin_b: f32) -> (f32, f32) {
 }
 
 /// Whether the tree holds each triangle of this light as a leaf of its own (meshes other
-/// than a single rectangle, which is sampled as a whole, by solid angle or by its texels).
+/// than a single rectangle, which is sampled as a whole, by solid angle or by its texels,
+/// and than a disk sampled by its texels).
 pub fn by_triangle(light: &Light) -> bool {
-    matches!(light, Light::Mesh { emitter, .. } if emitter.rectangle.is_none() && emitter.triangles.len() > 1)
+    matches!(light, Light::Mesh { emitter, importance: None, .. }
+        if emitter.rectangle.is_none() && emitter.triangles.len() > 1)
 }
 
 /// The bounds of triangle `t` of a mesh light split by triangle.
