@@ -80,9 +80,12 @@ proptest! {
         world.intersect_batch(&rays, &mut hits);
         let mut blocked = vec![false; rays.len()];
         world.occluded_batch(&rays, &mut blocked);
+        let mut in_packets = vec![rays.len() % 2 == 0; rays.len()];
+        world.occluded_packets(&rays, &mut in_packets);
         for (i, r) in rays.iter().enumerate() {
             prop_assert_eq!(hit_bits(&hits[i]), hit_bits(&world.intersect(r)), "ray {} {:?}", i, r);
             prop_assert_eq!(blocked[i], world.occluded(r), "ray {} {:?}", i, r);
+            prop_assert_eq!(in_packets[i], blocked[i], "packets: ray {} {:?}", i, r);
         }
     }
 }
@@ -99,6 +102,9 @@ fn batch_queries_see_the_instances_outside_the_flat_bvh() {
     let mut blocked = [false];
     world.occluded_batch(&[Ray::segment(rays[0].origin, rays[0].dir, 0.2)], &mut blocked);
     assert!(blocked[0], "the ball blocks the segment");
+    let mut blocked = [false];
+    world.occluded_packets(&[Ray::segment(rays[0].origin, rays[0].dir, 0.2)], &mut blocked);
+    assert!(blocked[0], "the ball blocks the segment in a packet too");
 }
 
 /// The one-path render and the two wavefront renders, which must match it.
