@@ -80,7 +80,7 @@ proptest! {
         world.intersect_batch(&rays, &mut hits);
         let mut blocked = vec![false; rays.len()];
         world.occluded_batch(&rays, &mut blocked);
-        let mut in_packets = vec![rays.len() % 2 == 0; rays.len()];
+        let mut in_packets = vec![rays.len().is_multiple_of(2); rays.len()];
         world.occluded_packets(&rays, &mut in_packets);
         for (i, r) in rays.iter().enumerate() {
             prop_assert_eq!(hit_bits(&hits[i]), hit_bits(&world.intersect(r)), "ray {} {:?}", i, r);
