@@ -205,7 +205,7 @@ pub fn bench_cmd(a: BenchArgs) -> Result<(), String> {
         // Same-run ratios: the figures that mean something on a shared machine.
         o.insert("batch_closest_speedup".into(), (closest_s / batch_closest_s).into());
         o.insert("batch_occluded_speedup".into(), (occluded_s / batch_occluded_s).into());
-        o.insert("packet_lanes".into(), packet_lanes(simd).into());
+        o.insert("packet_lanes".into(), glint::accel::packet_lanes(simd).into());
         o.insert("packet_split".into(), a.packet_split.into());
         o.insert("packet_occluded_mrays_per_s".into(), (n / packet_occluded_s / 1e6).into());
         o.insert("packet_occluded_speedup".into(), (occluded_s / packet_occluded_s).into());
@@ -226,15 +226,6 @@ fn print_result(out: &serde_json::Value, json: bool) {
 
 /// The batch API must give each ray the single-ray answer: the same triangle and the same
 /// distance and barycentrics, bit for bit, and the same occlusion.
-/// Rays per occlusion packet on a SIMD path (`TriangleWideBvh::occluded_packets`).
-fn packet_lanes(simd: SimdPath) -> usize {
-    match simd {
-        SimdPath::Avx512 => 16,
-        SimdPath::Avx2 => 8,
-        SimdPath::Sse | SimdPath::Scalar => 1,
-    }
-}
-
 fn check_batch(
     single: &[Option<(u32, TriangleHit)>],
     single_blocked: &[bool],

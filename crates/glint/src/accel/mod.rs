@@ -24,7 +24,7 @@ pub use simd::SimdPath;
 pub use top_level::{FlatMesh, TopLevelBvh};
 pub use triangle::{intersect_triangle, ShearedRay, TriangleHit};
 pub use wide::{WideBvh, WideStats};
-pub use wide_mesh::TriangleWideBvh;
+pub use wide_mesh::{packet_lanes, TriangleWideBvh};
 
 /// Asks the CPU to start loading the cache line that holds `value`, so that a later read of
 /// it waits less. Changes nothing else.

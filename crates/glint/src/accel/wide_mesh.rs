@@ -156,6 +156,18 @@ impl<'a, S: Isa> PacketLeaf for AnyPacket<'a, S> {
     }
 }
 
+/// Rays per packet of [`TriangleWideBvh::occluded_packets`] on `path`: the lanes of the
+/// implementation its dispatch picks.
+pub fn packet_lanes(path: SimdPath) -> usize {
+    match path {
+        #[cfg(target_arch = "x86_64")]
+        SimdPath::Avx512 => Avx512x16::N,
+        #[cfg(target_arch = "x86_64")]
+        SimdPath::Avx2 => Avx2x8::N,
+        _ => One::N,
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct TriangleWideBvh<const W: usize> {
     /// Private: traversal relies on leaf ranges being in range of `blocks`.
