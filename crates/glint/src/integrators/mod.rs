@@ -10,6 +10,7 @@ mod observe;
 mod path;
 mod path_batch;
 mod surface;
+mod vertex_lanes;
 mod volpath;
 mod whitted;
 
@@ -20,7 +21,7 @@ pub use crate::describe::{DirectSettings, PathSettings, Strategy, VolpathSetting
 pub use first_hit::{closest_hit_cost, first_hit, FirstHit};
 pub(crate) use observe::{NextEvent, PathObserver, Scattering};
 pub(crate) use path::{li as path_li, PathState};
-pub use path_batch::CameraSample;
+pub use path_batch::{CameraSample, PathShading};
 pub(crate) use surface::transmittance;
 
 use crate::materials::ShadedBsdf;
@@ -64,13 +65,14 @@ impl Integrator {
         &self,
         scene: &World,
         traversal: BatchTraversal,
+        shading: PathShading,
         samples: &mut [CameraSample],
         out: &mut [Rgb],
         counters: &mut Counters,
     ) {
         assert_eq!(samples.len(), out.len(), "li_batch: one radiance per sample");
         match self {
-            Integrator::Path(s) => path_batch::li_batch(s, scene, traversal, samples, out, counters),
+            Integrator::Path(s) => path_batch::li_batch(s, scene, traversal, shading, samples, out, counters),
             Integrator::Whitted(_) | Integrator::Direct(_) | Integrator::Volpath(_) => {
                 for (cs, o) in samples.iter_mut().zip(out.iter_mut()) {
                     *o = self.li(scene, &cs.ray, &mut cs.sampler, counters);

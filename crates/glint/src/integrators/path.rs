@@ -14,9 +14,10 @@ use super::observe::{NextEvent, PathObserver, Scattering, Unobserved};
 use super::surface::{passes_mask, transmittance};
 use super::{camera_hit, shading, shadow_ray, spawn_ray, Counters};
 use crate::describe::{PathSettings, Strategy};
-use crate::math::{Ray, Rgb};
+use crate::materials::ShadedBsdf;
+use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::{power_heuristic, Sampler};
-use crate::world::{Hit, World};
+use crate::world::{Hit, SurfaceInteraction, World};
 
 /// The longest path, in segments, even when `max_depth` is unbounded: a hard ceiling so that
 /// a path trapped between mirrors with a Russian roulette probability of 1 still ends. Light
@@ -42,9 +43,9 @@ pub fn li(s: &PathSettings, scene: &World, camera_ray: &Ray, rng: &mut Sampler, 
 pub(crate) struct ShadowQuery {
     pub ray: Ray,
     /// Throughput x BSDF x emitted radiance, before the MIS weight and the light's density.
-    contribution: Rgb,
-    mis_weight: f32,
-    light_pdf: f32,
+    pub contribution: Rgb,
+    pub mis_weight: f32,
+    pub light_pdf: f32,
 }
 
 /// One path between vertices: what it has gathered and what it traces next.
@@ -136,6 +137,24 @@ impl PathState {
         c: &mut Counters,
         observer: &mut O,
     ) {
+        let Some(si) = self.arrive(s, scene, hit, rng, observer) else { return };
+        let (bsdf, frame) = shading(scene, &si, -self.ray.dir);
+        self.scatter(s, scene, &si, &bsdf, &frame, rng, c, observer);
+    }
+
+    /// The first part of a step: the vertex is reached (depth counted, `tracing` cleared),
+    /// emission seen there or the environment seen on a miss is added, and a masked surface
+    /// may be passed. Returns the interaction where the path goes on to scatter there
+    /// ([`PathState::scatter`], after `shading`); `None` where the step is over.
+    #[inline]
+    pub(crate) fn arrive<O: PathObserver>(
+        &mut self,
+        s: &PathSettings,
+        scene: &World,
+        hit: Option<Hit>,
+        rng: &mut Sampler,
+        observer: &mut O,
+    ) -> Option<SurfaceInteraction> {
         self.tracing = false;
         self.depth += 1;
         let ray = self.ray;
@@ -143,7 +162,7 @@ impl PathState {
             if !(self.depth == 1 && s.hide_emitters) {
                 add_environment(scene, &ray, s.strategy, &self.prev, self.throughput, &mut self.l, observer);
             }
-            return;
+            return None;
         };
         let si = scene.interaction(&ray, &hit);
 
@@ -160,15 +179,29 @@ impl PathState {
             self.depth -= 1;
             self.ray = spawn_ray(&si, ray.dir);
             self.tracing = true;
-            return;
+            return None;
         }
         if self.depth >= self.max_depth {
-            return;
+            return None;
         }
+        Some(si)
+    }
 
-        let wo_world = -ray.dir;
-        let (bsdf, frame) = shading(scene, &si, wo_world);
-        let wo = frame.to_local(wo_world);
+    /// The rest of a step at `si`, whose BSDF and frame `shading` gave: a shadow ray for
+    /// next-event estimation, and the next ray by sampling the BSDF.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn scatter<O: PathObserver>(
+        &mut self,
+        s: &PathSettings,
+        scene: &World,
+        si: &SurfaceInteraction,
+        bsdf: &ShadedBsdf,
+        frame: &Frame,
+        rng: &mut Sampler,
+        c: &mut Counters,
+        observer: &mut O,
+    ) {
+        let wo = frame.to_local(-self.ray.dir);
 
         // Next-event estimation: one light, chosen by the scene's light distribution.
         if s.strategy != Strategy::Bsdf && !bsdf.is_delta() {
@@ -185,7 +218,7 @@ impl PathState {
                         power_heuristic(light_pdf, bsdf.pdf(wo, wi))
                     };
                     let throughput = self.throughput;
-                    let (si, bsdf, ls) = (&si, &bsdf, &ls);
+                    let ls = &ls;
                     observer.next_event(&NextEvent {
                         si,
                         bsdf,
@@ -220,16 +253,36 @@ impl PathState {
         if bs.weight.is_black() {
             return;
         }
-        observer.scattering(&Scattering { si: &si, bsdf: &bsdf, wo, wi: bs.wi, delta: bs.delta });
-        self.throughput *= bs.weight;
-        self.eta_scale *= bs.eta * bs.eta;
+        observer.scattering(&Scattering { si, bsdf, wo, wi: bs.wi, delta: bs.delta });
         let wi_world = frame.to_world(bs.wi);
-        self.prev = PrevEvent { pdf: bs.pdf, delta: bs.delta, p: si.p };
-        self.ray = spawn_ray(&si, wi_world);
+        let prev = PrevEvent { pdf: bs.pdf, delta: bs.delta, p: si.p };
+        self.go_on(s, bs.weight, bs.eta, prev, spawn_ray(si, wi_world), rng);
+    }
 
+    /// The end of a step whose BSDF sampled the next ray: the throughput takes the sample's
+    /// weight, and the path goes on unless Russian roulette ends it.
+    #[inline]
+    pub(crate) fn go_on(&mut self, s: &PathSettings, weight: Rgb, eta: f32, prev: PrevEvent, ray: Ray, rng: &mut Sampler) {
+        self.throughput *= weight;
+        self.eta_scale *= eta * eta;
+        self.prev = prev;
+        self.ray = ray;
         if self.depth >= s.rr_depth && !survives_roulette(&mut self.throughput, self.eta_scale, s.rr_probability, rng) {
             return;
         }
         self.tracing = true;
+    }
+
+    /// Leaves the shadow ray of next-event estimation (counted in `c`).
+    #[inline]
+    pub(crate) fn leave_shadow_ray(&mut self, q: ShadowQuery, c: &mut Counters) {
+        c.shadow_rays += 1;
+        self.shadow = Some(q);
+    }
+
+    /// The path's throughput so far.
+    #[inline]
+    pub(crate) fn throughput(&self) -> Rgb {
+        self.throughput
     }
 }

@@ -10,6 +10,7 @@
 
 use super::path::PathState;
 use super::surface::transmittance_if_blocked;
+use super::vertex_lanes::{LaneIsa, LaneStepper};
 use super::Counters;
 use crate::describe::PathSettings;
 use crate::math::{Ray, Rgb};
@@ -29,6 +30,7 @@ pub fn li_batch(
     s: &PathSettings,
     scene: &World,
     traversal: BatchTraversal,
+    shading: PathShading,
     samples: &mut [CameraSample],
     out: &mut [Rgb],
     c: &mut Counters,
@@ -71,17 +73,20 @@ pub fn li_batch(
             stepping.push(Stepping { path: i, hit });
         }
         order.sort_unstable();
-        if scene.prefetch_hits {
-            // The hit data of the paths a step or two ahead is fetched while this one steps:
-            // on large meshes the vertices a hit reads are cache misses (no bits change).
-            let ahead = |k: usize| order.get(k).and_then(|&o| stepping[o as u32 as usize].hit.as_ref());
+        if let PathShading::Lanes = shading {
+            // The same loop, the Lambertian vertices' arithmetic in lanes (`vertex_lanes`).
+            let mut stepper = LaneStepper::new(LaneIsa::detect());
             for (k, &o) in order.iter().enumerate() {
-                if let Some(h) = ahead(k + 2) {
-                    scene.prefetch_hit_indices(h);
+                if scene.prefetch_hits {
+                    prefetch_ahead(scene, &stepping, &order, k);
                 }
-                if let Some(h) = ahead(k + 1) {
-                    scene.prefetch_hit_vertices(h);
-                }
+                let st = &stepping[o as u32 as usize];
+                stepper.step(s, scene, &mut paths, samples, st.path, st.hit, c);
+            }
+            stepper.flush(s, &mut paths, samples, c);
+        } else if scene.prefetch_hits {
+            for (k, &o) in order.iter().enumerate() {
+                prefetch_ahead(scene, &stepping, &order, k);
                 let st = &stepping[o as u32 as usize];
                 paths[st.path].step(s, scene, st.hit, &mut samples[st.path].sampler, c);
             }
@@ -117,6 +122,30 @@ pub fn li_batch(
     for (o, p) in out.iter_mut().zip(&paths) {
         *o = p.l;
     }
+}
+
+/// Starts loading the hit data of the paths one and two places after the `k`-th in `order`:
+/// the hit data of the paths a step or two ahead is fetched while this one steps (on large
+/// meshes the vertices a hit reads are cache misses; no bits change).
+#[inline]
+fn prefetch_ahead(scene: &World, stepping: &[Stepping], order: &[u64], k: usize) {
+    let ahead = |k: usize| order.get(k).and_then(|&o| stepping[o as u32 as usize].hit.as_ref());
+    if let Some(h) = ahead(k + 2) {
+        scene.prefetch_hit_indices(h);
+    }
+    if let Some(h) = ahead(k + 1) {
+        scene.prefetch_hit_vertices(h);
+    }
+}
+
+/// How a wave's paths take their steps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PathShading {
+    /// One path after another through `PathState::step`.
+    OneByOne,
+    /// The vertices `vertex_lanes` covers in SIMD lanes (8 on AVX2, 16 on AVX-512, as
+    /// `GLINT_SIMD` and the CPU allow), the others one by one.
+    Lanes,
 }
 
 /// A path about to take its step, and the hit it takes it at.

@@ -17,7 +17,7 @@ pub use film::{Block, Film, PixelSums, Rect};
 pub(crate) use passes::camera_sample;
 pub use passes::{relative_error, render_passes, Adaptive, PassOutcome, PassRequest};
 
-use crate::integrators::Integrator;
+use crate::integrators::{Integrator, PathShading};
 use crate::io::Image;
 use crate::sampling::SamplerKind;
 use crate::world::{BatchTraversal, World};
@@ -56,12 +56,20 @@ pub enum Schedule {
     /// `accel::packet`): 1.07 to 1.36x the single rays' occlusion on the bunny and dragon ray
     /// sets, 0.8 to 0.9x on the room, about even in renders (BENCHMARKS.md), so not the default.
     WavefrontPackets,
+    /// As `WavefrontPackets`, the path tracer's Lambertian vertices shaded 8 or 16 paths per
+    /// instruction (`integrators::vertex_lanes`; the other BSDFs one path at a time).
+    WavefrontSimd,
 }
 
 impl Schedule {
     /// Every schedule (the tests render each and compare the bits).
-    pub const ALL: [Schedule; 4] =
-        [Schedule::OnePath, Schedule::Wavefront, Schedule::WavefrontInterleaved, Schedule::WavefrontPackets];
+    pub const ALL: [Schedule; 5] = [
+        Schedule::OnePath,
+        Schedule::Wavefront,
+        Schedule::WavefrontInterleaved,
+        Schedule::WavefrontPackets,
+        Schedule::WavefrontSimd,
+    ];
 
     /// How the wavefront schedules trace their batches (`None`: one path at a time).
     pub fn batch_traversal(self) -> Option<BatchTraversal> {
@@ -69,7 +77,17 @@ impl Schedule {
             Schedule::OnePath => None,
             Schedule::Wavefront => Some(BatchTraversal::OneByOne),
             Schedule::WavefrontInterleaved => Some(BatchTraversal::Interleaved),
-            Schedule::WavefrontPackets => Some(BatchTraversal::Packets),
+            Schedule::WavefrontPackets | Schedule::WavefrontSimd => Some(BatchTraversal::Packets),
+        }
+    }
+
+    /// How the wavefront schedules step their paths.
+    pub fn path_shading(self) -> PathShading {
+        match self {
+            Schedule::WavefrontSimd => PathShading::Lanes,
+            Schedule::OnePath | Schedule::Wavefront | Schedule::WavefrontInterleaved | Schedule::WavefrontPackets => {
+                PathShading::OneByOne
+            }
         }
     }
 
@@ -80,6 +98,7 @@ impl Schedule {
             Schedule::Wavefront => "wavefront",
             Schedule::WavefrontInterleaved => "wavefront-interleaved",
             Schedule::WavefrontPackets => "wavefront-packets",
+            Schedule::WavefrontSimd => "wavefront-simd",
         }
     }
 }

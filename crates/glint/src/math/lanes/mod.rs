@@ -53,6 +53,10 @@ pub unsafe trait Lanes: Copy + Send + Sync + 'static {
     fn mul(self, a: Self::F, b: Self::F) -> Self::F;
     fn div(self, a: Self::F, b: Self::F) -> Self::F;
     fn sqrt(self, a: Self::F) -> Self::F;
+    /// `-a`: the sign bit flipped (NaNs included), as Rust's unary minus.
+    fn neg(self, a: Self::F) -> Self::F;
+    /// `a.abs()`: the sign bit cleared.
+    fn abs(self, a: Self::F) -> Self::F;
     /// `if a > b { a } else { b }`: `b` when either is NaN and when both are zeros (x86's
     /// `maxps`, the rule of every traversal kernel).
     fn max(self, a: Self::F, b: Self::F) -> Self::F;
@@ -72,6 +76,8 @@ pub unsafe trait Lanes: Copy + Send + Sync + 'static {
     fn or(self, a: Self::M, b: Self::M) -> Self::M;
     /// `a && !b`.
     fn and_not(self, a: Self::M, b: Self::M) -> Self::M;
+    /// `!a`.
+    fn not(self, a: Self::M) -> Self::M;
     /// `if m { a } else { b }`, lane by lane.
     fn select(self, m: Self::M, a: Self::F, b: Self::F) -> Self::F;
     /// Lane i's boolean in bit i.

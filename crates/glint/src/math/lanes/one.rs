@@ -46,6 +46,14 @@ unsafe impl Lanes for One {
         a.sqrt()
     }
     #[inline(always)]
+    fn neg(self, a: f32) -> f32 {
+        -a
+    }
+    #[inline(always)]
+    fn abs(self, a: f32) -> f32 {
+        a.abs()
+    }
+    #[inline(always)]
     fn max(self, a: f32, b: f32) -> f32 {
         if a > b {
             a
@@ -100,6 +108,10 @@ unsafe impl Lanes for One {
     #[inline(always)]
     fn and_not(self, a: bool, b: bool) -> bool {
         a & !b
+    }
+    #[inline(always)]
+    fn not(self, a: bool) -> bool {
+        !a
     }
     #[inline(always)]
     fn select(self, m: bool, a: f32, b: f32) -> f32 {

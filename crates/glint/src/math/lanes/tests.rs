@@ -67,7 +67,11 @@ fn check<L: Lanes>(l: L, name: &str) {
         // and the comparisons.
         let b: Vec<f32> = (0..n).map(|i| if round % 2 == 0 && i % 3 == 0 { a[i] } else { value(&mut rng) }).collect();
         let (va, vb) = (l.load(&a), l.load(&b));
-        let unary: [Unary<L::F>; 1] = [("sqrt", l.sqrt(va), |x| One.sqrt(x))];
+        let unary: [Unary<L::F>; 3] = [
+            ("sqrt", l.sqrt(va), |x| One.sqrt(x)),
+            ("neg", l.neg(va), |x| One.neg(x)),
+            ("abs", l.abs(va), |x| One.abs(x)),
+        ];
         let binary: [Binary<L::F>; 6] = [
             ("add", l.add(va, vb), |x, y| One.add(x, y)),
             ("sub", l.sub(va, vb), |x, y| One.sub(x, y)),
@@ -110,6 +114,7 @@ fn check<L: Lanes>(l: L, name: &str) {
         assert_eq!(l.bits(l.and(p, q)), pb & qb, "{name} and");
         assert_eq!(l.bits(l.or(p, q)), pb | qb, "{name} or");
         assert_eq!(l.bits(l.and_not(p, q)), pb & !qb, "{name} and_not");
+        assert_eq!(l.bits(l.not(p)), !pb & ((1u32 << n) - 1), "{name} not");
         l.store(l.select(p, va, vb), &mut out);
         for i in 0..n {
             let want = One.select(pb >> i & 1 == 1, a[i], b[i]);

@@ -73,6 +73,14 @@ unsafe impl Lanes for Avx2x8 {
         unsafe { _mm256_sqrt_ps(a) }
     }
     #[inline(always)]
+    fn neg(self, a: __m256) -> __m256 {
+        unsafe { _mm256_xor_ps(a, _mm256_set1_ps(-0.0)) }
+    }
+    #[inline(always)]
+    fn abs(self, a: __m256) -> __m256 {
+        unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), a) }
+    }
+    #[inline(always)]
     fn max(self, a: __m256, b: __m256) -> __m256 {
         unsafe { _mm256_max_ps(a, b) }
     }
@@ -121,6 +129,10 @@ unsafe impl Lanes for Avx2x8 {
     fn and_not(self, a: __m256, b: __m256) -> __m256 {
         // `andnps` complements its first operand.
         unsafe { _mm256_andnot_ps(b, a) }
+    }
+    #[inline(always)]
+    fn not(self, a: __m256) -> __m256 {
+        unsafe { _mm256_xor_ps(a, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) }
     }
     #[inline(always)]
     fn select(self, m: __m256, a: __m256, b: __m256) -> __m256 {
@@ -196,6 +208,15 @@ unsafe impl Lanes for Avx512x16 {
         unsafe { _mm512_sqrt_ps(a) }
     }
     #[inline(always)]
+    fn neg(self, a: __m512) -> __m512 {
+        // AVX-512F has no float xor (that is DQ): the sign bit flipped as an integer.
+        unsafe { _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(a), _mm512_set1_epi32(i32::MIN))) }
+    }
+    #[inline(always)]
+    fn abs(self, a: __m512) -> __m512 {
+        unsafe { _mm512_castsi512_ps(_mm512_and_si512(_mm512_castps_si512(a), _mm512_set1_epi32(i32::MAX))) }
+    }
+    #[inline(always)]
     fn max(self, a: __m512, b: __m512) -> __m512 {
         unsafe { _mm512_max_ps(a, b) }
     }
@@ -243,6 +264,10 @@ unsafe impl Lanes for Avx512x16 {
     #[inline(always)]
     fn and_not(self, a: __mmask16, b: __mmask16) -> __mmask16 {
         a & !b
+    }
+    #[inline(always)]
+    fn not(self, a: __mmask16) -> __mmask16 {
+        !a
     }
     #[inline(always)]
     fn select(self, m: __mmask16, a: __m512, b: __m512) -> __m512 {

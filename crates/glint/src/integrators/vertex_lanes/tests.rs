@@ -1,0 +1,232 @@
+//! Each lane of the diffuse kernel against the one-path code it replaces (`PathState::scatter`
+//! for a Lambertian BSDF, through the real `Diffuse`, `power_heuristic`, `shadow_ray`,
+//! `spawn_ray` and `Frame`), bit for bit, on every instruction set the CPU has: random
+//! vertices, and special values (NaN, ±0, infinities, grazing and backfacing directions,
+//! black reflectances, infinite light distances). NaNs compare equal whatever their sign and
+//! payload: Rust leaves those unspecified (LLVM may swap the operands of a multiplication),
+//! and the film discards a sample that is not finite.
+
+use super::*;
+use crate::integrators::{shadow_ray, spawn_ray};
+use crate::materials::{Bsdf, Diffuse};
+use crate::sampling::{power_heuristic, Rng};
+
+/// What the one-path code leaves: the shadow ray and its contribution and weight, and the
+/// next ray and its density.
+#[derive(Debug, PartialEq)]
+struct Outcome {
+    shadow: Option<([u32; 3], [u32; 3], u32, [u32; 3], u32)>,
+    next: Option<([u32; 3], [u32; 3], u32)>,
+}
+
+/// The bits of `x`, one pattern for every NaN.
+fn bits1(x: f32) -> u32 {
+    if x.is_nan() {
+        f32::NAN.to_bits()
+    } else {
+        x.to_bits()
+    }
+}
+
+fn bits(v: Vec3) -> [u32; 3] {
+    [bits1(v.x), bits1(v.y), bits1(v.z)]
+}
+
+/// One lane's vertex.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    dir: Vec3,
+    p: Vec3,
+    ng: Vec3,
+    frame: Frame,
+    reflectance: Rgb,
+    throughput: Rgb,
+    light: Option<LightSample>,
+    pick_pmf: f32,
+    u: [f32; 2],
+}
+
+fn reference(v: &Vertex, light_only: bool) -> Outcome {
+    let si = SurfaceInteraction {
+        p: v.p,
+        ng: v.ng,
+        frame: v.frame,
+        uv: [0.0; 2],
+        instance: 0,
+        material: 0,
+        light: None,
+        t: 1.0,
+        dpdu: Vec3::ZERO,
+        dpdv: Vec3::ZERO,
+        prim: 0,
+        bary: [0.0; 2],
+    };
+    let bsdf = Bsdf::Diffuse(Diffuse { reflectance: v.reflectance });
+    let wo = v.frame.to_local(-v.dir);
+    let mut shadow = None;
+    if let Some(ls) = v.light {
+        let wi = v.frame.to_local(ls.wi);
+        let f = bsdf.eval(wo, wi);
+        if !f.is_black() {
+            let light_pdf = v.pick_pmf * ls.pdf;
+            let mis = if ls.delta || light_only { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
+            let r = shadow_ray(&si, ls.wi, ls.dist);
+            let c = v.throughput * f * ls.radiance;
+            shadow = Some((bits(r.origin), bits(r.dir), bits1(r.t_max), bits(vec3(c.r, c.g, c.b)), bits1(mis)));
+        }
+    }
+    let next = bsdf.sample(wo, 0.5, v.u).filter(|bs| !bs.weight.is_black()).map(|bs| {
+        let r = spawn_ray(&si, v.frame.to_world(bs.wi));
+        (bits(r.origin), bits(r.dir), bits1(bs.pdf))
+    });
+    Outcome { shadow, next }
+}
+
+fn fill(c: &mut DiffuseChunk, i: usize, v: &Vertex) {
+    c.len = c.len.max(i + 1);
+    put3(&mut c.dir, i, [v.dir.x, v.dir.y, v.dir.z]);
+    put3(&mut c.p, i, [v.p.x, v.p.y, v.p.z]);
+    put3(&mut c.ng, i, [v.ng.x, v.ng.y, v.ng.z]);
+    put3(&mut c.n, i, [v.frame.n.x, v.frame.n.y, v.frame.n.z]);
+    put3(&mut c.s, i, [v.frame.s.x, v.frame.s.y, v.frame.s.z]);
+    put3(&mut c.t, i, [v.frame.t.x, v.frame.t.y, v.frame.t.z]);
+    put3(&mut c.reflectance, i, v.reflectance.to_array());
+    put3(&mut c.throughput, i, v.throughput.to_array());
+    c.has_light[i] = flag(v.light.is_some());
+    let ls = v.light.unwrap_or(LightSample {
+        wi: Vec3::Z,
+        radiance: Rgb::BLACK,
+        pdf: 1.0,
+        dist: 1.0,
+        delta: false,
+    });
+    put3(&mut c.light_wi, i, [ls.wi.x, ls.wi.y, ls.wi.z]);
+    c.light_dist[i] = ls.dist;
+    put3(&mut c.light_radiance, i, ls.radiance.to_array());
+    c.light_pdf[i] = v.pick_pmf * ls.pdf;
+    c.light_delta[i] = flag(ls.delta);
+    c.u[0][i] = v.u[0];
+    c.u[1][i] = v.u[1];
+}
+
+fn outcome(c: &DiffuseChunk, i: usize) -> Outcome {
+    let shadow = (c.shadow[i] != 0.0).then(|| {
+        (
+            bits(get3(&c.shadow_origin, i)),
+            bits(get3(&c.shadow_dir, i)),
+            bits1(c.shadow_t_max[i]),
+            bits(get3(&c.contribution, i)),
+            bits1(c.mis_weight[i]),
+        )
+    });
+    let next = (c.sampled[i] != 0.0).then(|| (bits(get3(&c.next_origin, i)), bits(get3(&c.next_dir, i)), bits1(c.pdf[i])));
+    Outcome { shadow, next }
+}
+
+const SPECIAL: [f32; 10] = [0.0, -0.0, 1.0, -1.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-30, -1e30, 0.5];
+
+/// A value that is special one time in `1 / rate`, else uniform in [-range, range].
+fn value(rng: &mut Rng, range: f32, rate: u32) -> f32 {
+    if rng.next_u32() % rate == 0 {
+        SPECIAL[(rng.next_u32() % SPECIAL.len() as u32) as usize]
+    } else {
+        (2.0 * rng.next_f32() - 1.0) * range
+    }
+}
+
+fn vector(rng: &mut Rng, range: f32, rate: u32) -> Vec3 {
+    vec3(value(rng, range, rate), value(rng, range, rate), value(rng, range, rate))
+}
+
+fn unit(rng: &mut Rng, rate: u32) -> Vec3 {
+    let v = vector(rng, 1.0, rate);
+    let n = v.normalize();
+    if n.is_finite() {
+        n
+    } else {
+        v
+    }
+}
+
+fn vertex(rng: &mut Rng) -> Vertex {
+    // Mostly sane vertices (special values in one coordinate in 40), so that every branch
+    // runs often: lights in front and behind, samples kept and rejected.
+    let n = unit(rng, 40);
+    let frame = Frame::from_normal(n);
+    // Directions near the tangent plane now and then (grazing).
+    let dir = if rng.next_u32() % 8 == 0 { frame.s * -1.0 + n * value(rng, 1e-6, 40) } else { unit(rng, 40) };
+    let light = (rng.next_u32() % 5 != 0).then(|| LightSample {
+        wi: if rng.next_u32() % 8 == 0 { frame.t + n * value(rng, 1e-6, 40) } else { unit(rng, 40) },
+        radiance: Rgb::from_array([value(rng, 10.0, 40).abs(), value(rng, 10.0, 40).abs(), value(rng, 10.0, 40).abs()]),
+        pdf: value(rng, 100.0, 40).abs(),
+        dist: if rng.next_u32() % 6 == 0 { f32::INFINITY } else { value(rng, 50.0, 40).abs() },
+        delta: rng.next_u32() % 7 == 0,
+    });
+    let black = rng.next_u32() % 10 == 0;
+    let refl = |rng: &mut Rng| if black { 0.0 } else { rng.next_f32() };
+    Vertex {
+        dir,
+        p: vector(rng, 100.0, 40),
+        ng: if rng.next_u32() % 2 == 0 { n } else { unit(rng, 40) },
+        frame,
+        reflectance: Rgb::from_array([refl(rng), refl(rng), refl(rng)]),
+        throughput: Rgb::from_array([value(rng, 4.0, 40).abs(), value(rng, 4.0, 40).abs(), rng.next_f32()]),
+        light,
+        pick_pmf: value(rng, 1.0, 40).abs(),
+        // Sampler numbers are in [0, 1); the centre of the square and its edges now and then.
+        u: match rng.next_u32() % 10 {
+            0 => [0.5, 0.5],
+            1 => [0.0, rng.next_f32()],
+            2 => [0.5, rng.next_f32()],
+            _ => [rng.next_f32(), rng.next_f32()],
+        },
+    }
+}
+
+fn check(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(23, lanes as u64);
+    let (mut shadows, mut samples, mut total) = (0, 0, 0);
+    for round in 0..4000 {
+        let light_only = round % 5 == 0;
+        let vertices: Vec<Vertex> = (0..lanes).map(|_| vertex(&mut rng)).collect();
+        let mut chunk = DiffuseChunk::default();
+        // A part-full chunk now and then: the lanes past `len` must not matter.
+        let used = if round % 7 == 0 { 1 + round % lanes } else { lanes };
+        for (i, v) in vertices.iter().take(used).enumerate() {
+            fill(&mut chunk, i, v);
+        }
+        chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
+        for (i, v) in vertices.iter().take(used).enumerate() {
+            let want = reference(v, light_only);
+            total += 1;
+            shadows += want.shadow.is_some() as u32;
+            samples += want.next.is_some() as u32;
+            assert_eq!(outcome(&chunk, i), want, "{isa:?} lane {i}, round {round}: {v:?}");
+        }
+    }
+    // The inputs exercise both outcomes of both halves often (about a fifth of the vertices
+    // leave a shadow ray, two fifths a next ray).
+    assert!(
+        shadows > total / 8 && shadows < total && samples > total / 4 && samples < total,
+        "{isa:?}: {shadows} shadow rays, {samples} samples of {total} vertices"
+    );
+}
+
+#[test]
+fn every_lane_scatters_as_the_one_path_code_does() {
+    check(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check(LaneIsa::Avx2);
+        } else {
+            eprintln!("no AVX2 on this CPU: the eight-lane kernel is not tested here");
+        }
+        if Avx512x16::new().is_some() {
+            check(LaneIsa::Avx512);
+        } else {
+            eprintln!("no AVX-512F on this CPU: the sixteen-lane kernel is not tested here");
+        }
+    }
+}
