@@ -187,6 +187,16 @@ impl PathState {
         Some(si)
     }
 
+    /// What [`PathState::arrive`] does at a hit that the caller knows neither emits light
+    /// nor may be passed (no mask, no culled back face): the vertex is reached. Returns
+    /// whether the path goes on to scatter there (it has not reached its depth limit).
+    #[inline]
+    pub(crate) fn arrive_opaque(&mut self) -> bool {
+        self.tracing = false;
+        self.depth += 1;
+        self.depth < self.max_depth
+    }
+
     /// The rest of a step at `si`, whose BSDF and frame `shading` gave: a shadow ray for
     /// next-event estimation, and the next ray by sampling the BSDF.
     #[allow(clippy::too_many_arguments)]

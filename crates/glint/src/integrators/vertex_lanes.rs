@@ -26,7 +26,7 @@ use super::observe::Unobserved;
 use super::path::{PathState, ShadowQuery};
 use super::path_batch::CameraSample;
 use super::{shading, Counters};
-use crate::materials::{Bsdf, ShadedBsdf};
+use crate::materials::{Bsdf, DiffuseMaterial, MaterialKind, ShadedBsdf, Texture};
 use crate::accel::SimdPath;
 use crate::describe::{PathSettings, Strategy};
 use crate::lights::LightSample;
@@ -35,7 +35,7 @@ use crate::math::lanes::{Lanes, One, MAX_LANES};
 use crate::math::lanes::{Avx2x8, Avx512x16};
 use crate::math::{vec3, Frame, Ray, Rgb, Vec3, INV_PI, PI};
 use crate::sampling::Sampler;
-use crate::world::{Hit, SurfaceInteraction, World};
+use crate::world::{Hit, ShapeRef, SurfaceInteraction, World};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -98,6 +98,18 @@ pub(crate) struct DiffuseChunk {
     light_delta: Column,
     // In: the BSDF's square sample.
     u: [Column; 2],
+    // In, for lanes whose interaction the kernel computes (`from_mesh` 1): the hit triangle of
+    // an untransformed mesh, its barycentrics, vertex normals and uvs where the mesh has them,
+    // and the instance's and material's flags. The kernel then writes `ng`, `n`, `s`, `t`.
+    from_mesh: Column,
+    corners: [Column3; 3],
+    bary: Column3,
+    has_normals: Column,
+    normals: [Column3; 3],
+    has_uvs: Column,
+    uvs: [[Column; 2]; 3],
+    flip_normals: Column,
+    two_sided: Column,
     // Out: the shadow ray (`shadow` 0 where there is none).
     shadow: Column,
     shadow_origin: Column3,
@@ -134,6 +146,15 @@ impl Default for DiffuseChunk {
             light_pdf: c,
             light_delta: c,
             u: [c; 2],
+            from_mesh: c,
+            corners: [c3; 3],
+            bary: c3,
+            has_normals: c,
+            normals: [c3; 3],
+            has_uvs: c,
+            uvs: [[c; 2]; 3],
+            flip_normals: c,
+            two_sided: c,
             shadow: c,
             shadow_origin: c3,
             shadow_dir: c3,
@@ -171,35 +192,80 @@ impl DiffuseChunk {
         self.len >= lanes
     }
 
-    /// Adds a path's vertex as the next lane, drawing its random numbers from `rng` as
-    /// `PathState::scatter` does: the light sample (unless the strategy samples only the
-    /// BSDF), then the BSDF's lobe number (unused by a Lambertian BSDF, drawn all the same)
-    /// and square.
+    /// Adds a path's vertex as the next lane, its interaction and frame computed by the scalar
+    /// code, drawing its random numbers from `rng` as `PathState::scatter` does (see
+    /// [`DiffuseChunk::push_common`]).
     #[allow(clippy::too_many_arguments)]
     pub fn push(
         &mut self,
         path_index: u32,
         path: &PathState,
-        s: &PathSettings,
         si: &SurfaceInteraction,
         frame: &Frame,
         reflectance: Rgb,
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
+        let i = self.push_common(path_index, path, si.p, reflectance, light, rng);
+        self.from_mesh[i] = 0.0;
+        put3(&mut self.ng, i, [si.ng.x, si.ng.y, si.ng.z]);
+        put3(&mut self.n, i, [frame.n.x, frame.n.y, frame.n.z]);
+        put3(&mut self.s, i, [frame.s.x, frame.s.y, frame.s.z]);
+        put3(&mut self.t, i, [frame.t.x, frame.t.y, frame.t.z]);
+    }
+
+    /// Adds a path's vertex on an untransformed mesh as the next lane, its interaction and
+    /// frame left to the kernel (`p` is the hit point `World::interaction` gives).
+    #[allow(clippy::too_many_arguments)]
+    pub fn push_mesh(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        hit: &MeshHit,
+        p: Vec3,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) {
+        let i = self.push_common(path_index, path, p, hit.reflectance, light, rng);
+        self.from_mesh[i] = 1.0;
+        for (k, v) in hit.corners.iter().enumerate() {
+            put3(&mut self.corners[k], i, [v.x, v.y, v.z]);
+        }
+        put3(&mut self.bary, i, hit.bary);
+        self.has_normals[i] = flag(hit.normals.is_some());
+        for (k, v) in hit.normals.unwrap_or([Vec3::ZERO; 3]).iter().enumerate() {
+            put3(&mut self.normals[k], i, [v.x, v.y, v.z]);
+        }
+        self.has_uvs[i] = flag(hit.uvs.is_some());
+        for (k, uv) in hit.uvs.unwrap_or([[0.0; 2]; 3]).iter().enumerate() {
+            self.uvs[k][0][i] = uv[0];
+            self.uvs[k][1][i] = uv[1];
+        }
+        self.flip_normals[i] = flag(hit.flip_normals);
+        self.two_sided[i] = flag(hit.two_sided);
+    }
+
+    /// The lane's path, ray, hit point, reflectance and throughput, its light sample, and the
+    /// BSDF's random numbers drawn from `rng` as `PathState::scatter` draws them after the
+    /// light sample: the lobe number (unused by a Lambertian BSDF, drawn all the same) and
+    /// the square. Returns the lane.
+    fn push_common(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        p: Vec3,
+        reflectance: Rgb,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) -> usize {
         let i = self.len;
         self.len += 1;
         self.path[i] = path_index;
         let d = path.ray.dir;
         put3(&mut self.dir, i, [d.x, d.y, d.z]);
-        put3(&mut self.p, i, [si.p.x, si.p.y, si.p.z]);
-        put3(&mut self.ng, i, [si.ng.x, si.ng.y, si.ng.z]);
-        put3(&mut self.n, i, [frame.n.x, frame.n.y, frame.n.z]);
-        put3(&mut self.s, i, [frame.s.x, frame.s.y, frame.s.z]);
-        put3(&mut self.t, i, [frame.t.x, frame.t.y, frame.t.z]);
+        put3(&mut self.p, i, [p.x, p.y, p.z]);
         put3(&mut self.reflectance, i, reflectance.to_array());
         put3(&mut self.throughput, i, path.throughput().to_array());
-        debug_assert!(light.is_none() || s.strategy != Strategy::Bsdf);
         match light {
             Some((ls, pick_pmf)) => {
                 self.has_light[i] = 1.0;
@@ -223,6 +289,7 @@ impl DiffuseChunk {
         let u = rng.next_2d();
         self.u[0][i] = u[0];
         self.u[1][i] = u[1];
+        i
     }
 
     /// Runs the kernel over the chunk's lanes on `isa`.
@@ -282,6 +349,7 @@ unsafe fn diffuse_chunk_avx512(chunk: &mut DiffuseChunk, light_only: bool) {
 fn diffuse_chunk<L: Lanes>(l: L, c: &mut DiffuseChunk, light_only: bool) {
     let mut base = 0;
     while base < c.len {
+        mesh_frames(l, c, base);
         diffuse_lanes(l, c, base, light_only);
         base += L::N;
     }
@@ -445,6 +513,116 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, light_only: 
     store3(l, offset_origin(l, p, ng, wi), &mut c.next_origin, base);
 }
 
+/// `Frame::from_normal(n)` (Duff et al.'s basis), in its operations.
+#[inline(always)]
+fn frame_from_normal<L: Lanes>(l: L, n: V3<L::F>) -> (V3<L::F>, V3<L::F>) {
+    let one = l.splat(1.0);
+    // `1.0f32.copysign(n.z)`.
+    let sign = l.select(l.sign(n.z), l.splat(-1.0), one);
+    let a = l.div(l.splat(-1.0), l.add(sign, n.z));
+    let b = l.mul(l.mul(n.x, n.y), a);
+    let s = V3 {
+        x: l.add(one, l.mul(l.mul(l.mul(sign, n.x), n.x), a)),
+        y: l.mul(sign, b),
+        z: l.mul(l.neg(sign), n.x),
+    };
+    let t = V3 { x: b, y: l.add(sign, l.mul(l.mul(n.y, n.y), a)), z: l.neg(n.y) };
+    (s, t)
+}
+
+/// Whether every component is finite (`Vec3::is_finite`).
+#[inline(always)]
+fn finite3<L: Lanes>(l: L, v: V3<L::F>) -> L::M {
+    let inf = l.splat(f32::INFINITY);
+    l.and(l.and(l.lt(l.abs(v.x), inf), l.lt(l.abs(v.y), inf)), l.lt(l.abs(v.z), inf))
+}
+
+#[inline(always)]
+fn cross<L: Lanes>(l: L, a: V3<L::F>, b: V3<L::F>) -> V3<L::F> {
+    V3 {
+        x: l.sub(l.mul(a.y, b.z), l.mul(a.z, b.y)),
+        y: l.sub(l.mul(a.z, b.x), l.mul(a.x, b.z)),
+        z: l.sub(l.mul(a.x, b.y), l.mul(a.y, b.x)),
+    }
+}
+
+#[inline(always)]
+fn neg3<L: Lanes>(l: L, a: V3<L::F>) -> V3<L::F> {
+    V3 { x: l.neg(a.x), y: l.neg(a.y), z: l.neg(a.z) }
+}
+
+/// `v.normalize()`: `v * (1 / |v|)`.
+#[inline(always)]
+fn normalize<L: Lanes>(l: L, v: V3<L::F>) -> V3<L::F> {
+    scale(l, v, l.div(l.splat(1.0), l.sqrt(dot(l, v, v))))
+}
+
+/// For the lanes of untransformed meshes: `World::interaction`'s geometric normal and
+/// shading frame (interpolated normals, dp/du from the uvs), then `shading`'s turn of a
+/// two-sided material's frame towards the viewer, written to the `ng`, `n`, `s`, `t` columns;
+/// the other lanes keep theirs.
+#[inline(always)]
+fn mesh_frames<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize) {
+    let zero = l.splat(0.0);
+    let yes = |col: &Column| l.gt(l.load(&col[base..]), zero);
+    let from_mesh = yes(&c.from_mesh);
+    if l.bits(from_mesh) == 0 {
+        return;
+    }
+    let [a, b, cc] = c.corners.each_ref().map(|k| load3(l, k, base));
+    let [b0, b1, b2] = [0, 1, 2].map(|k| l.load(&c.bary[k][base..]));
+    let e1 = sub3(l, b, a);
+    let e2 = sub3(l, cc, a);
+    let ng_obj = cross(l, e1, e2);
+    // dp/du: from the uvs (`triangle_dpduv`), else the edge b - a.
+    let [t0, t1, t2] = c.uvs.each_ref().map(|uv| (l.load(&uv[0][base..]), l.load(&uv[1][base..])));
+    let (du0, dv0) = (l.sub(t1.0, t0.0), l.sub(t1.1, t0.1));
+    let (du1, dv1) = (l.sub(t2.0, t0.0), l.sub(t2.1, t0.1));
+    let det = l.sub(l.mul(du0, dv1), l.mul(dv0, du1));
+    let inv = l.div(l.splat(1.0), det);
+    let dpdu_uv = scale(l, sub3(l, scale(l, e1, dv1), scale(l, e2, dv0)), inv);
+    let dpdv_uv = scale(l, sub3(l, scale(l, e2, du0), scale(l, e1, du1)), inv);
+    let uv_ok = l.and(l.ne(det, zero), l.and(finite3(l, dpdu_uv), finite3(l, dpdv_uv)));
+    let (fallback_s, _) = frame_from_normal(l, normalize(l, ng_obj));
+    let dpdu_mesh = select3(l, uv_ok, dpdu_uv, fallback_s);
+    let dpdu = select3(l, yes(&c.has_uvs), dpdu_mesh, e1);
+    // The geometric normal, and the shading normal: the interpolated one where the mesh
+    // has normals and it is not zero, else the geometric one; the geometric one again where
+    // that is not finite.
+    let flip = yes(&c.flip_normals);
+    let ng_unit = normalize(l, ng_obj);
+    let ng = select3(l, flip, neg3(l, ng_unit), ng_unit);
+    let [n0, n1, n2] = c.normals.each_ref().map(|k| load3(l, k, base));
+    let ns = add3(l, add3(l, scale(l, n0, b0), scale(l, n1, b1)), scale(l, n2, b2));
+    let ns_unit = normalize(l, ns);
+    let ns_unit = select3(l, flip, neg3(l, ns_unit), ns_unit);
+    let use_ns = l.and(yes(&c.has_normals), l.gt(dot(l, ns, ns), zero));
+    let n_shading = select3(l, use_ns, ns_unit, ng);
+    let n_shading = select3(l, finite3(l, n_shading), n_shading, ng);
+    // `Frame::from_normal_tangent(n_shading, dpdu)`.
+    let s_raw = sub3(l, dpdu, scale(l, n_shading, dot(l, n_shading, dpdu)));
+    let len2 = dot(l, s_raw, s_raw);
+    let tangent_ok = l.and(
+        l.gt(len2, l.mul(l.splat(1e-20), dot(l, dpdu, dpdu))),
+        l.lt(l.abs(len2), l.splat(f32::INFINITY)),
+    );
+    let s_unit = scale(l, s_raw, l.div(l.splat(1.0), l.sqrt(len2)));
+    let (basis_s, basis_t) = frame_from_normal(l, n_shading);
+    let s = select3(l, tangent_ok, s_unit, basis_s);
+    let t = select3(l, tangent_ok, cross(l, n_shading, s_unit), basis_t);
+    // `shading`: a two-sided material's frame faces the viewer (`-ray.dir`).
+    let dir = load3(l, &c.dir, base);
+    let facing_away = l.lt(dot(l, n_shading, neg3(l, dir)), zero);
+    let turn = l.and(yes(&c.two_sided), facing_away);
+    let n = select3(l, turn, neg3(l, n_shading), n_shading);
+    let keep = |new: V3<L::F>, col: &Column3| select3(l, from_mesh, new, load3(l, col, base));
+    let (ng, n, s, t) = (keep(ng, &c.ng), keep(n, &c.n), keep(s, &c.s), keep(t, &c.t));
+    store3(l, ng, &mut c.ng, base);
+    store3(l, n, &mut c.n, base);
+    store3(l, s, &mut c.s, base);
+    store3(l, t, &mut c.t, base);
+}
+
 /// `warp::sin_cos_quarter`, in its operations and constants.
 #[inline(always)]
 fn sin_cos_quarter<L: Lanes>(l: L, t: L::F) -> (L::F, L::F) {
@@ -456,6 +634,55 @@ fn sin_cos_quarter<L: Lanes>(l: L, t: L::F) -> (L::F, L::F) {
     let cos_mid = l.add(c(1.0 / 24.0), l.mul(t2, l.add(c(-1.0 / 720.0), l.mul(t2, cos_inner))));
     let cos = l.add(c(1.0), l.mul(t2, l.add(c(-0.5), l.mul(t2, cos_mid))));
     (sin, cos)
+}
+
+/// A hit on an untransformed triangle mesh that neither emits nor may be passed, of a
+/// Lambertian material with a constant reflectance: the lanes compute its interaction.
+pub(crate) struct MeshHit {
+    corners: [Vec3; 3],
+    bary: [f32; 3],
+    normals: Option<[Vec3; 3]>,
+    uvs: Option<[[f32; 2]; 3]>,
+    reflectance: Rgb,
+    flip_normals: bool,
+    two_sided: bool,
+}
+
+impl MeshHit {
+    /// The hit, where the lanes cover it, and its point as `World::interaction` computes it.
+    #[inline]
+    fn of(scene: &World, hit: &Hit) -> Option<(MeshHit, Vec3)> {
+        let inst = scene.instances.get(hit.instance as usize)?;
+        let ShapeRef::Mesh(m) = inst.shape else { return None };
+        if inst.light.is_some() || inst.to_world.is_some() {
+            return None;
+        }
+        let mat = scene.materials.get(inst.material as usize)?;
+        // A plain `Diffuse` kind has no mask, normal or bump map (those wrap it).
+        let MaterialKind::Diffuse(DiffuseMaterial { reflectance: Texture::Constant(reflectance) }) = &mat.kind else {
+            return None;
+        };
+        if mat.cull_back_faces {
+            return None;
+        }
+        let mesh = scene.meshes.get(m as usize)?;
+        let tri = hit.prim as usize;
+        let [i0, i1, i2] = *mesh.indices.get(tri)?;
+        let [a, b, c] = mesh.vertices(tri);
+        let b0 = 1.0 - hit.b1 - hit.b2;
+        let p = a * b0 + b * hit.b1 + c * hit.b2;
+        let (i0, i1, i2) = (i0 as usize, i1 as usize, i2 as usize);
+        let at = MeshHit {
+            corners: [a, b, c],
+            bary: [b0, hit.b1, hit.b2],
+            normals: mesh.normals.as_ref().map(|n| [n[i0], n[i1], n[i2]]),
+            uvs: mesh.uvs.as_ref().map(|t| [t[i0], t[i1], t[i2]]),
+            reflectance: *reflectance,
+            flip_normals: inst.flip_normals,
+            two_sided: mat.two_sided,
+        };
+        Some((at, p))
+    }
 }
 
 /// Steps the paths of a wave as `PathState::step` does, the Lambertian vertices through the
@@ -488,21 +715,39 @@ impl LaneStepper {
     ) {
         let path = &mut paths[i];
         let rng = &mut samples[i].sampler;
+        if let Some((mesh_hit, p)) = hit.as_ref().and_then(|h| MeshHit::of(scene, h)) {
+            // What `arrive` does at a surface that neither emits nor may be passed.
+            if !path.arrive_opaque() {
+                return;
+            }
+            let light = self.light_sample(s, scene, p, rng);
+            self.chunk.push_mesh(i as u32, path, &mesh_hit, p, light, rng);
+            if self.chunk.is_full(self.lanes) {
+                self.flush(s, paths, samples, c);
+            }
+            return;
+        }
         let Some(si) = path.arrive(s, scene, hit, rng, &mut Unobserved) else { return };
         let (bsdf, frame) = shading(scene, &si, -path.ray.dir);
         let Some(reflectance) = plain_diffuse(&bsdf) else {
             path.scatter(s, scene, &si, &bsdf, &frame, rng, c, &mut Unobserved);
             return;
         };
-        let light = if s.strategy != Strategy::Bsdf {
-            sample_light(scene, si.p, rng).map(|(ls, pick_pmf, _)| (ls, pick_pmf))
-        } else {
-            None
-        };
-        self.chunk.push(i as u32, path, s, &si, &frame, reflectance, light, rng);
+        let light = self.light_sample(s, scene, si.p, rng);
+        self.chunk.push(i as u32, path, &si, &frame, reflectance, light, rng);
         if self.chunk.is_full(self.lanes) {
             self.flush(s, paths, samples, c);
         }
+    }
+
+    /// Next-event estimation's light sample at `p` and the light's probability, as
+    /// `PathState::scatter` draws it for a BSDF that is not delta.
+    #[inline]
+    fn light_sample(&self, s: &PathSettings, scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
+        if s.strategy == Strategy::Bsdf {
+            return None;
+        }
+        sample_light(scene, p, rng).map(|(ls, pick_pmf, _)| (ls, pick_pmf))
     }
 
     /// Runs the waiting vertices and finishes their steps.

@@ -592,31 +592,16 @@ impl World {
 
     pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
         let inst = &self.instances[hit.instance as usize];
-        let (p, mut ng, mut ns, uv, dpdu, dpdv) = match inst.shape {
+        let (p, ng, mut ns, uv, dpdu, dpdv) = match inst.shape {
             ShapeRef::Mesh(m) => {
                 let mesh = &self.meshes[m as usize];
                 let tri = hit.prim as usize;
-                let [i0, i1, i2] = mesh.indices[tri];
-                let [a, b, c] = mesh.vertices(tri);
-                let b0 = 1.0 - hit.b1 - hit.b2;
-                let p_obj = a * b0 + b * hit.b1 + c * hit.b2;
-                let ng_obj = (b - a).cross(c - a);
-                let ns_obj = mesh
-                    .normals
-                    .as_ref()
-                    .map(|n| n[i0 as usize] * b0 + n[i1 as usize] * hit.b1 + n[i2 as usize] * hit.b2);
-                let (uv, dpdu, dpdv) = match mesh.uvs.as_ref() {
-                    None => ([hit.b1, hit.b2], b - a, c - a),
-                    Some(t) => {
-                        let (t0, t1, t2) = (t[i0 as usize], t[i1 as usize], t[i2 as usize]);
-                        let uv = [
-                            t0[0] * b0 + t1[0] * hit.b1 + t2[0] * hit.b2,
-                            t0[1] * b0 + t1[1] * hit.b1 + t2[1] * hit.b2,
-                        ];
-                        let (dpdu, dpdv) = triangle_dpduv([a, b, c], [t0, t1, t2], ng_obj);
-                        (uv, dpdu, dpdv)
-                    }
-                };
+                let [i0, i1, i2] = mesh.indices[tri].map(|i| i as usize);
+                let corners = mesh.vertices(tri);
+                let normals = mesh.normals.as_ref().map(|n| [n[i0], n[i1], n[i2]]);
+                let uvs = mesh.uvs.as_ref().map(|t| [t[i0], t[i1], t[i2]]);
+                let TriangleSurface { p: p_obj, ng: ng_obj, ns: ns_obj, uv, dpdu, dpdv } =
+                    TriangleSurface::at(corners, normals, uvs, hit.b1, hit.b2);
                 match &inst.to_world {
                     None => (p_obj, ng_obj, ns_obj, uv, dpdu, dpdv),
                     Some(t) => {
@@ -652,24 +637,7 @@ impl World {
                 (q.p, q.n, None, q.uv, q.dpdu, q.dpdv)
             }
         };
-        ng = ng.normalize();
-        if inst.flip_normals {
-            ng = -ng;
-        }
-        let mut n_shading = match ns.take() {
-            Some(n) if n.length_squared() > 0.0 => {
-                let n = n.normalize();
-                if inst.flip_normals {
-                    -n
-                } else {
-                    n
-                }
-            }
-            _ => ng,
-        };
-        if !n_shading.is_finite() {
-            n_shading = ng;
-        }
+        let (ng, n_shading) = unit_normals(ng, ns.take(), inst.flip_normals);
         SurfaceInteraction {
             p,
             ng,
@@ -745,6 +713,71 @@ impl World {
             })
             .sum()
     }
+}
+
+/// What a triangle's corners, vertex normals and uvs (where the mesh has them) give at the
+/// barycentrics (b1, b2): the point, the face normal (not normalised, counter-clockwise
+/// winding in front), the interpolated normal, the uv and dp/du, dp/dv (see
+/// [`SurfaceInteraction`]).
+pub(crate) struct TriangleSurface {
+    pub p: Vec3,
+    pub ng: Vec3,
+    pub ns: Option<Vec3>,
+    pub uv: [f32; 2],
+    pub dpdu: Vec3,
+    pub dpdv: Vec3,
+}
+
+impl TriangleSurface {
+    #[inline]
+    pub(crate) fn at(
+        [a, b, c]: [Vec3; 3],
+        normals: Option<[Vec3; 3]>,
+        uvs: Option<[[f32; 2]; 3]>,
+        b1: f32,
+        b2: f32,
+    ) -> TriangleSurface {
+        let b0 = 1.0 - b1 - b2;
+        let p = a * b0 + b * b1 + c * b2;
+        let ng = (b - a).cross(c - a);
+        let ns = normals.map(|n| n[0] * b0 + n[1] * b1 + n[2] * b2);
+        let (uv, dpdu, dpdv) = match uvs {
+            None => ([b1, b2], b - a, c - a),
+            Some([t0, t1, t2]) => {
+                let uv = [t0[0] * b0 + t1[0] * b1 + t2[0] * b2, t0[1] * b0 + t1[1] * b1 + t2[1] * b2];
+                let (dpdu, dpdv) = triangle_dpduv([a, b, c], [t0, t1, t2], ng);
+                (uv, dpdu, dpdv)
+            }
+        };
+        TriangleSurface { p, ng, ns, uv, dpdu, dpdv }
+    }
+}
+
+/// The unit geometric normal and the shading normal of a hit from the shape's normal `ng`
+/// (any length) and interpolated normal `ns`, both turned where the instance flips normals:
+/// the shading normal is `ns` where there is one and it is not zero, else `ng`, and `ng`
+/// again where it is not finite.
+#[inline]
+pub(crate) fn unit_normals(ng: Vec3, ns: Option<Vec3>, flip_normals: bool) -> (Vec3, Vec3) {
+    let mut ng = ng.normalize();
+    if flip_normals {
+        ng = -ng;
+    }
+    let mut n_shading = match ns {
+        Some(n) if n.length_squared() > 0.0 => {
+            let n = n.normalize();
+            if flip_normals {
+                -n
+            } else {
+                n
+            }
+        }
+        _ => ng,
+    };
+    if !n_shading.is_finite() {
+        n_shading = ng;
+    }
+    (ng, n_shading)
 }
 
 /// The traversal hit of a curve: `prim` its segment's first control point, `b1` the

@@ -10,6 +10,7 @@ use super::*;
 use crate::integrators::{shadow_ray, spawn_ray};
 use crate::materials::{Bsdf, Diffuse};
 use crate::sampling::{power_heuristic, Rng};
+use crate::world::{unit_normals, TriangleSurface};
 
 /// What the one-path code leaves: the shadow ray and its contribution and weight, and the
 /// next ray and its density.
@@ -227,6 +228,96 @@ fn every_lane_scatters_as_the_one_path_code_does() {
             check(LaneIsa::Avx512);
         } else {
             eprintln!("no AVX-512F on this CPU: the sixteen-lane kernel is not tested here");
+        }
+    }
+}
+
+/// A triangle hit for the interaction kernel: random corners (degenerate ones and special
+/// values now and then), normals (zero ones too) and uvs (repeated ones, a zero determinant).
+fn mesh_hit(rng: &mut Rng) -> (MeshHit, Vec3, Vec3) {
+    let a = vector(rng, 10.0, 60);
+    let b = if rng.next_u32() % 12 == 0 { a } else { vector(rng, 10.0, 60) };
+    let c = vector(rng, 10.0, 60);
+    let b1 = rng.next_f32();
+    let b2 = rng.next_f32() * (1.0 - b1);
+    let normals = (rng.next_u32() % 3 != 0).then(|| {
+        if rng.next_u32() % 10 == 0 {
+            [Vec3::ZERO; 3]
+        } else {
+            [unit(rng, 60), unit(rng, 60), unit(rng, 60)]
+        }
+    });
+    let uvs = (rng.next_u32() % 3 != 0).then(|| {
+        let t0 = [value(rng, 1.0, 60), value(rng, 1.0, 60)];
+        let t1 = if rng.next_u32() % 10 == 0 { t0 } else { [value(rng, 1.0, 60), value(rng, 1.0, 60)] };
+        [t0, t1, [value(rng, 1.0, 60), value(rng, 1.0, 60)]]
+    });
+    let hit = MeshHit {
+        corners: [a, b, c],
+        bary: [1.0 - b1 - b2, b1, b2],
+        normals,
+        uvs,
+        reflectance: Rgb::from_array([rng.next_f32(), rng.next_f32(), rng.next_f32()]),
+        flip_normals: rng.next_u32() % 4 == 0,
+        two_sided: rng.next_u32() % 2 == 0,
+    };
+    let p = TriangleSurface::at(hit.corners, hit.normals, hit.uvs, b1, b2).p;
+    (hit, p, unit(rng, 40))
+}
+
+/// `World::interaction`'s normals and frame for the hit (its mesh branch, without a
+/// transform), then `shading`'s turn of a two-sided frame.
+fn reference_frame(hit: &MeshHit, dir: Vec3) -> (Vec3, Frame) {
+    let surface = TriangleSurface::at(hit.corners, hit.normals, hit.uvs, hit.bary[1], hit.bary[2]);
+    let (ng, ns) = unit_normals(surface.ng, surface.ns, hit.flip_normals);
+    let mut frame = Frame::from_normal_tangent(ns, surface.dpdu);
+    if hit.two_sided && frame.n.dot(-dir) < 0.0 {
+        frame = Frame { s: frame.s, t: frame.t, n: -frame.n };
+    }
+    (ng, frame)
+}
+
+fn check_mesh_frames(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(29, lanes as u64);
+    for round in 0..4000 {
+        let mut chunk = DiffuseChunk::default();
+        let mut want = Vec::new();
+        for i in 0..lanes {
+            // Every third lane arrives with its frame from the scalar code: it must keep it.
+            if i % 3 == 2 {
+                let v = vertex(&mut rng);
+                fill(&mut chunk, i, &v);
+                want.push((v.ng, v.frame));
+            } else {
+                let (hit, p, dir) = mesh_hit(&mut rng);
+                chunk.len = i;
+                let mut sampler = Sampler::from_rng(Rng::new(1, i as u64));
+                let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, dir));
+                chunk.push_mesh(i as u32, &path, &hit, p, None, &mut sampler);
+                want.push(reference_frame(&hit, dir));
+            }
+        }
+        chunk.len = lanes;
+        chunk.run(isa, Strategy::Mis);
+        for (i, (ng, frame)) in want.iter().enumerate() {
+            let got = [get3(&chunk.ng, i), get3(&chunk.n, i), get3(&chunk.s, i), get3(&chunk.t, i)].map(bits);
+            let expected = [*ng, frame.n, frame.s, frame.t].map(bits);
+            assert_eq!(got, expected, "{isa:?} lane {i}, round {round}");
+        }
+    }
+}
+
+#[test]
+fn every_lane_finds_the_mesh_frame_the_one_path_code_finds() {
+    check_mesh_frames(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check_mesh_frames(LaneIsa::Avx2);
+        }
+        if Avx512x16::new().is_some() {
+            check_mesh_frames(LaneIsa::Avx512);
         }
     }
 }
