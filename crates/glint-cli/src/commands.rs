@@ -142,11 +142,13 @@ pub struct RunArgs {
     /// Write the raw film (same format as a checkpoint) when done, for `glint merge`.
     #[arg(long, value_name = "FILE")]
     pub film_out: Option<PathBuf>,
-    /// How paths are scheduled: wavefront (a tile's paths advanced together, a bounce at a
-    /// time; the default), wavefront-interleaved (the same, each batch traced with several
-    /// rays in flight), wavefront-packets (the same, shadow rays traced in packets of 8 or
-    /// 16) or one-path (each path to its end). Same image under each.
-    #[arg(long, default_value = "wavefront")]
+    /// How paths are scheduled: wavefront-simd (a tile's paths advanced together, a bounce at
+    /// a time, shadow rays traced in packets and Lambertian vertices shaded 8 or 16 paths per
+    /// instruction; the default), wavefront (the same, one ray and one vertex at a time),
+    /// wavefront-interleaved (each batch traced with several rays in flight),
+    /// wavefront-packets (shadow rays in packets, vertices one at a time) or one-path (each
+    /// path to its end). Same image under each.
+    #[arg(long, default_value = "wavefront-simd")]
     pub schedule: Schedule,
     /// Serve a live view of the render in the browser at ADDR (HOST:PORT or PORT; default
     /// 127.0.0.1 at a free port, printed on start): the image as passes land, its layers, a

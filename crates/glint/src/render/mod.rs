@@ -46,8 +46,7 @@ pub enum Schedule {
     OnePath,
     /// Up to [`WAVEFRONT_PATHS`] paths of a tile advanced together, a bounce at a time, each
     /// batch of rays traced through the single-ray kernels (only the path tracer batches;
-    /// other integrators run one path at a time). The default: the fastest measured.
-    #[default]
+    /// other integrators run one path at a time).
     Wavefront,
     /// As `Wavefront`, the batches traced by the interleaved batch traversal (several rays in
     /// flight per thread): 3 to 5% slower than `Wavefront` on Zen 5 (BENCHMARKS.md).
@@ -57,7 +56,9 @@ pub enum Schedule {
     /// sets, 0.8 to 0.9x on the room, about even in renders (BENCHMARKS.md), so not the default.
     WavefrontPackets,
     /// As `WavefrontPackets`, the path tracer's Lambertian vertices shaded 8 or 16 paths per
-    /// instruction (`integrators::vertex_lanes`; the other BSDFs one path at a time).
+    /// instruction (`integrators::vertex_lanes`; the other BSDFs one path at a time). The
+    /// default: the fastest measured (BENCHMARKS.md, "The vertex in SIMD lanes").
+    #[default]
     WavefrontSimd,
 }
 
@@ -126,7 +127,7 @@ impl Default for RenderSettings {
             sampler: SamplerKind::Sobol,
             variance: false,
             tile_size: 16,
-            schedule: Schedule::Wavefront,
+            schedule: Schedule::WavefrontSimd,
         }
     }
 }
