@@ -110,8 +110,9 @@ fn batch_queries_see_the_instances_outside_the_flat_bvh() {
 /// The one-path render and the two wavefront renders, which must match it.
 fn render_all(world: &World, integrator: &Integrator, settings: &RenderSettings) -> (RenderOutput, Vec<RenderOutput>) {
     let one = render(world, integrator, &RenderSettings { schedule: Schedule::OnePath, ..settings.clone() }, &Silent);
-    let waves = [Schedule::Wavefront, Schedule::WavefrontInterleaved, Schedule::WavefrontPackets, Schedule::WavefrontSimd]
-        .map(|schedule| render(world, integrator, &RenderSettings { schedule, ..settings.clone() }, &Silent));
+    let waves =
+        [Schedule::Wavefront, Schedule::WavefrontInterleaved, Schedule::WavefrontPackets, Schedule::WavefrontSimd]
+            .map(|schedule| render(world, integrator, &RenderSettings { schedule, ..settings.clone() }, &Silent));
     (one, waves.into())
 }
 

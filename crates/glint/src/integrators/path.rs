@@ -272,7 +272,15 @@ impl PathState {
     /// The end of a step whose BSDF sampled the next ray: the throughput takes the sample's
     /// weight, and the path goes on unless Russian roulette ends it.
     #[inline]
-    pub(crate) fn go_on(&mut self, s: &PathSettings, weight: Rgb, eta: f32, prev: PrevEvent, ray: Ray, rng: &mut Sampler) {
+    pub(crate) fn go_on(
+        &mut self,
+        s: &PathSettings,
+        weight: Rgb,
+        eta: f32,
+        prev: PrevEvent,
+        ray: Ray,
+        rng: &mut Sampler,
+    ) {
         self.throughput *= weight;
         self.eta_scale *= eta * eta;
         self.prev = prev;

@@ -270,7 +270,14 @@ impl PassJob<'_> {
         wave.radiance.clear();
         wave.radiance.resize(wave.cameras.len(), Rgb::BLACK);
         let shading = self.settings.schedule.path_shading();
-        self.integrator.li_batch(self.scene, traversal, shading, &mut wave.cameras, &mut wave.radiance, &mut counts.counters);
+        self.integrator.li_batch(
+            self.scene,
+            traversal,
+            shading,
+            &mut wave.cameras,
+            &mut wave.radiance,
+            &mut counts.counters,
+        );
         for ((origin, camera), &l) in wave.origins.iter().zip(&wave.cameras).zip(&wave.radiance) {
             let i = origin.index;
             let aov = &mut aov_sums[i * self.stride..(i + 1) * self.stride];

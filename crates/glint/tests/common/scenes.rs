@@ -44,7 +44,9 @@ pub fn path(strategy: Strategy) -> Integrator {
 pub fn render_with(scene: &World, integrator: &Integrator, spp: u32, seed: u64) -> RenderOutput {
     let out = render(scene, integrator, &settings(spp, seed), &Silent);
     assert_eq!(out.stats.discarded_samples, 0, "the renderer produced NaN, infinite or negative samples");
-    for schedule in [Schedule::Wavefront, Schedule::WavefrontInterleaved, Schedule::WavefrontPackets, Schedule::WavefrontSimd] {
+    for schedule in
+        [Schedule::Wavefront, Schedule::WavefrontInterleaved, Schedule::WavefrontPackets, Schedule::WavefrontSimd]
+    {
         let other = render(scene, integrator, &RenderSettings { schedule, ..settings(spp, seed) }, &Silent);
         assert_same_bits(&out, &other);
     }

@@ -6,10 +6,14 @@
 //! payload: Rust leaves those unspecified (LLVM may swap the operands of a multiplication),
 //! and the film discards a sample that is not finite.
 
+use super::conductor::MirrorChunk;
+use super::diffuse::DiffuseChunk;
 use super::*;
 use crate::integrators::{shadow_ray, spawn_ray};
-use crate::materials::{Bsdf, Diffuse};
+use crate::materials::{Bsdf, Conductor, Diffuse};
+use crate::math::{Frame, Ray};
 use crate::sampling::{power_heuristic, Rng};
+use crate::world::SurfaceInteraction;
 use crate::world::{unit_normals, TriangleSurface};
 
 /// What the one-path code leaves: the shadow ray and its contribution and weight, and the
@@ -94,13 +98,7 @@ fn fill(c: &mut DiffuseChunk, i: usize, v: &Vertex) {
     put3(&mut c.reflectance, i, v.reflectance.to_array());
     put3(&mut c.throughput, i, v.throughput.to_array());
     c.has_light[i] = flag(v.light.is_some());
-    let ls = v.light.unwrap_or(LightSample {
-        wi: Vec3::Z,
-        radiance: Rgb::BLACK,
-        pdf: 1.0,
-        dist: 1.0,
-        delta: false,
-    });
+    let ls = v.light.unwrap_or(LightSample { wi: Vec3::Z, radiance: Rgb::BLACK, pdf: 1.0, dist: 1.0, delta: false });
     put3(&mut c.light_wi, i, [ls.wi.x, ls.wi.y, ls.wi.z]);
     c.light_dist[i] = ls.dist;
     put3(&mut c.light_radiance, i, ls.radiance.to_array());
@@ -120,7 +118,8 @@ fn outcome(c: &DiffuseChunk, i: usize) -> Outcome {
             bits1(c.mis_weight[i]),
         )
     });
-    let next = (c.sampled[i] != 0.0).then(|| (bits(get3(&c.next_origin, i)), bits(get3(&c.next_dir, i)), bits1(c.pdf[i])));
+    let next =
+        (c.sampled[i] != 0.0).then(|| (bits(get3(&c.next_origin, i)), bits(get3(&c.next_dir, i)), bits1(c.pdf[i])));
     Outcome { shadow, next }
 }
 
@@ -318,6 +317,75 @@ fn every_lane_finds_the_mesh_frame_the_one_path_code_finds() {
         }
         if Avx512x16::new().is_some() {
             check_mesh_frames(LaneIsa::Avx512);
+        }
+    }
+}
+
+/// The smooth conductor's lane against `Conductor::sample`, `Frame::to_world` and
+/// `spawn_ray`: the next ray and the weight, or no sample.
+fn check_mirrors(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(31, lanes as u64);
+    let mut kept = 0;
+    let mut total = 0;
+    for round in 0..4000 {
+        let mut chunk = MirrorChunk::default();
+        let mut want = Vec::new();
+        for i in 0..lanes {
+            let v = vertex(&mut rng);
+            // Gold-like to dielectric-like constants, and special values now and then.
+            let mirror = Conductor {
+                eta: Rgb::from_array([value(&mut rng, 3.0, 30).abs(), value(&mut rng, 3.0, 30), 1.5]),
+                k: Rgb::from_array([value(&mut rng, 5.0, 30).abs(), 0.0, value(&mut rng, 5.0, 30)]),
+                specular: if round % 9 == 0 { Rgb::BLACK } else { Rgb::from_array([1.0, rng.next_f32(), 0.5]) },
+            };
+            let si = SurfaceInteraction {
+                p: v.p,
+                ng: v.ng,
+                frame: v.frame,
+                uv: [0.0; 2],
+                instance: 0,
+                material: 0,
+                light: None,
+                t: 1.0,
+                dpdu: Vec3::ZERO,
+                dpdv: Vec3::ZERO,
+                prim: 0,
+                bary: [0.0; 2],
+            };
+            let mut sampler = Sampler::from_rng(Rng::new(2, i as u64));
+            let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
+            chunk.push(i as u32, &path, &si, &v.frame, &mirror, &mut sampler);
+            let wo = v.frame.to_local(-v.dir);
+            let sample = Bsdf::Conductor(mirror).sample(wo, 0.5, [0.5, 0.5]).filter(|bs| !bs.weight.is_black());
+            want.push(sample.map(|bs| {
+                let r = spawn_ray(&si, v.frame.to_world(bs.wi));
+                (bits(r.origin), bits(r.dir), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)))
+            }));
+        }
+        chunk.run(isa);
+        for (i, w) in want.iter().enumerate() {
+            let got = (chunk.sampled[i] != 0.0).then(|| {
+                (bits(get3(&chunk.next_origin, i)), bits(get3(&chunk.next_dir, i)), bits(get3(&chunk.weight, i)))
+            });
+            assert_eq!(&got, w, "{isa:?} lane {i}, round {round}");
+            total += 1;
+            kept += w.is_some() as u32;
+        }
+    }
+    assert!(kept > total / 4 && kept < total, "{isa:?}: {kept} samples kept of {total}");
+}
+
+#[test]
+fn every_lane_mirrors_as_the_one_path_code_does() {
+    check_mirrors(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check_mirrors(LaneIsa::Avx2);
+        }
+        if Avx512x16::new().is_some() {
+            check_mirrors(LaneIsa::Avx512);
         }
     }
 }

@@ -1,0 +1,443 @@
+//! The Lambertian vertex in lanes: for lanes of untransformed meshes the interaction's
+//! normals and frame (`mesh_frames`), then the BSDF towards the light, the MIS weight, the
+//! shadow ray, the cosine sample and the next ray (`diffuse_lanes`), as
+//! `PathState::scatter` computes them for `Bsdf::Diffuse`.
+
+use super::lane_math::*;
+use super::{flag, get3, put3, Column, Column3, LaneIsa, MeshHit};
+use crate::describe::{PathSettings, Strategy};
+use crate::integrators::estimators::PrevEvent;
+use crate::integrators::path::{PathState, ShadowQuery};
+use crate::integrators::Counters;
+use crate::lights::LightSample;
+#[cfg(target_arch = "x86_64")]
+use crate::math::lanes::{Avx2x8, Avx512x16};
+use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::{Frame, Ray, Rgb, Vec3, INV_PI, PI};
+use crate::sampling::Sampler;
+use crate::world::SurfaceInteraction;
+
+/// Up to [`MAX_LANES`] diffuse vertices, one per lane: what the scalar code gathered, and what
+/// the kernel leaves. Flags are 1.0 (true) or 0.0.
+#[derive(Clone, Copy)]
+pub(crate) struct DiffuseChunk {
+    pub len: usize,
+    /// Which path each lane is (the caller's index).
+    pub path: [u32; MAX_LANES],
+    // In: the vertex.
+    pub(super) dir: Column3,
+    pub(super) p: Column3,
+    pub(super) ng: Column3,
+    pub(super) n: Column3,
+    pub(super) s: Column3,
+    pub(super) t: Column3,
+    pub(super) reflectance: Column3,
+    pub(super) throughput: Column3,
+    // In: the light sample (`has_light` 0 where there is none).
+    pub(super) has_light: Column,
+    pub(super) light_wi: Column3,
+    pub(super) light_dist: Column,
+    pub(super) light_radiance: Column3,
+    pub(super) light_pdf: Column,
+    pub(super) light_delta: Column,
+    // In: the BSDF's square sample.
+    pub(super) u: [Column; 2],
+    // In, for lanes whose interaction the kernel computes (`from_mesh` 1): the hit triangle of
+    // an untransformed mesh, its barycentrics, vertex normals and uvs where the mesh has them,
+    // and the instance's and material's flags. The kernel then writes `ng`, `n`, `s`, `t`.
+    pub(super) from_mesh: Column,
+    pub(super) corners: [Column3; 3],
+    pub(super) bary: Column3,
+    pub(super) has_normals: Column,
+    pub(super) normals: [Column3; 3],
+    pub(super) has_uvs: Column,
+    pub(super) uvs: [[Column; 2]; 3],
+    pub(super) flip_normals: Column,
+    pub(super) two_sided: Column,
+    // Out: the shadow ray (`shadow` 0 where there is none).
+    pub(super) shadow: Column,
+    pub(super) shadow_origin: Column3,
+    pub(super) shadow_dir: Column3,
+    pub(super) shadow_t_max: Column,
+    pub(super) contribution: Column3,
+    pub(super) mis_weight: Column,
+    // Out: the next ray (`sampled` 0 where the path ends).
+    pub(super) sampled: Column,
+    pub(super) next_origin: Column3,
+    pub(super) next_dir: Column3,
+    pub(super) pdf: Column,
+}
+
+impl Default for DiffuseChunk {
+    fn default() -> Self {
+        let c = [0.0; MAX_LANES];
+        let c3 = [c; 3];
+        DiffuseChunk {
+            len: 0,
+            path: [0; MAX_LANES],
+            dir: c3,
+            p: c3,
+            ng: c3,
+            n: c3,
+            s: c3,
+            t: c3,
+            reflectance: c3,
+            throughput: c3,
+            has_light: c,
+            light_wi: c3,
+            light_dist: c,
+            light_radiance: c3,
+            light_pdf: c,
+            light_delta: c,
+            u: [c; 2],
+            from_mesh: c,
+            corners: [c3; 3],
+            bary: c3,
+            has_normals: c,
+            normals: [c3; 3],
+            has_uvs: c,
+            uvs: [[c; 2]; 3],
+            flip_normals: c,
+            two_sided: c,
+            shadow: c,
+            shadow_origin: c3,
+            shadow_dir: c3,
+            shadow_t_max: c,
+            contribution: c3,
+            mis_weight: c,
+            sampled: c,
+            next_origin: c3,
+            next_dir: c3,
+            pdf: c,
+        }
+    }
+}
+
+impl DiffuseChunk {
+    pub fn is_full(&self, lanes: usize) -> bool {
+        self.len >= lanes
+    }
+
+    /// Adds a path's vertex as the next lane, its interaction and frame computed by the scalar
+    /// code, drawing its random numbers from `rng` as `PathState::scatter` does (see
+    /// [`DiffuseChunk::push_common`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        si: &SurfaceInteraction,
+        frame: &Frame,
+        reflectance: Rgb,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) {
+        let i = self.push_common(path_index, path, si.p, reflectance, light, rng);
+        self.from_mesh[i] = 0.0;
+        put3(&mut self.ng, i, [si.ng.x, si.ng.y, si.ng.z]);
+        put3(&mut self.n, i, [frame.n.x, frame.n.y, frame.n.z]);
+        put3(&mut self.s, i, [frame.s.x, frame.s.y, frame.s.z]);
+        put3(&mut self.t, i, [frame.t.x, frame.t.y, frame.t.z]);
+    }
+
+    /// Adds a path's vertex on an untransformed mesh as the next lane, its interaction and
+    /// frame left to the kernel (`p` is the hit point `World::interaction` gives).
+    #[allow(clippy::too_many_arguments)]
+    pub fn push_mesh(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        hit: &MeshHit,
+        p: Vec3,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) {
+        let i = self.push_common(path_index, path, p, hit.reflectance, light, rng);
+        self.from_mesh[i] = 1.0;
+        for (k, v) in hit.corners.iter().enumerate() {
+            put3(&mut self.corners[k], i, [v.x, v.y, v.z]);
+        }
+        put3(&mut self.bary, i, hit.bary);
+        self.has_normals[i] = flag(hit.normals.is_some());
+        for (k, v) in hit.normals.unwrap_or([Vec3::ZERO; 3]).iter().enumerate() {
+            put3(&mut self.normals[k], i, [v.x, v.y, v.z]);
+        }
+        self.has_uvs[i] = flag(hit.uvs.is_some());
+        for (k, uv) in hit.uvs.unwrap_or([[0.0; 2]; 3]).iter().enumerate() {
+            self.uvs[k][0][i] = uv[0];
+            self.uvs[k][1][i] = uv[1];
+        }
+        self.flip_normals[i] = flag(hit.flip_normals);
+        self.two_sided[i] = flag(hit.two_sided);
+    }
+
+    /// The lane's path, ray, hit point, reflectance and throughput, its light sample, and the
+    /// BSDF's random numbers drawn from `rng` as `PathState::scatter` draws them after the
+    /// light sample: the lobe number (unused by a Lambertian BSDF, drawn all the same) and
+    /// the square. Returns the lane.
+    fn push_common(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        p: Vec3,
+        reflectance: Rgb,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) -> usize {
+        let i = self.len;
+        self.len += 1;
+        self.path[i] = path_index;
+        let d = path.ray.dir;
+        put3(&mut self.dir, i, [d.x, d.y, d.z]);
+        put3(&mut self.p, i, [p.x, p.y, p.z]);
+        put3(&mut self.reflectance, i, reflectance.to_array());
+        put3(&mut self.throughput, i, path.throughput().to_array());
+        match light {
+            Some((ls, pick_pmf)) => {
+                self.has_light[i] = 1.0;
+                put3(&mut self.light_wi, i, [ls.wi.x, ls.wi.y, ls.wi.z]);
+                self.light_dist[i] = ls.dist;
+                put3(&mut self.light_radiance, i, ls.radiance.to_array());
+                self.light_pdf[i] = pick_pmf * ls.pdf;
+                self.light_delta[i] = flag(ls.delta);
+            }
+            None => {
+                // Finite values in the unused lanes: nothing is computed from them.
+                self.has_light[i] = 0.0;
+                put3(&mut self.light_wi, i, [0.0, 0.0, 1.0]);
+                self.light_dist[i] = 1.0;
+                put3(&mut self.light_radiance, i, [0.0; 3]);
+                self.light_pdf[i] = 1.0;
+                self.light_delta[i] = 0.0;
+            }
+        }
+        let _u_lobe = rng.next_f32();
+        let u = rng.next_2d();
+        self.u[0][i] = u[0];
+        self.u[1][i] = u[1];
+        i
+    }
+
+    /// Runs the kernel over the chunk's lanes on `isa`.
+    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
+        let light_only = strategy == Strategy::Light;
+        match isa {
+            LaneIsa::One => diffuse_chunk(One, self, light_only),
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
+            LaneIsa::Avx2 => unsafe { diffuse_chunk_avx2(self, light_only) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
+            LaneIsa::Avx512 => unsafe { diffuse_chunk_avx512(self, light_only) },
+        }
+    }
+
+    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
+        if self.shadow[i] != 0.0 {
+            path.leave_shadow_ray(
+                ShadowQuery {
+                    ray: Ray::segment(get3(&self.shadow_origin, i), get3(&self.shadow_dir, i), self.shadow_t_max[i]),
+                    contribution: Rgb::from_array(get3(&self.contribution, i).to_array()),
+                    mis_weight: self.mis_weight[i],
+                    light_pdf: self.light_pdf[i],
+                },
+                c,
+            );
+        }
+        if self.sampled[i] == 0.0 {
+            return;
+        }
+        let weight = Rgb::from_array(get3(&self.reflectance, i).to_array());
+        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.p, i) };
+        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
+        path.go_on(s, weight, 1.0, prev, ray, rng);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn diffuse_chunk_avx2(chunk: &mut DiffuseChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX2.
+    diffuse_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+unsafe fn diffuse_chunk_avx512(chunk: &mut DiffuseChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX-512F.
+    diffuse_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
+}
+
+/// Every lane of the chunk in vectors of `L::N` (the unused lanes of the last vector compute
+/// on whatever their columns hold, and nothing reads their results).
+#[inline(always)]
+fn diffuse_chunk<L: Lanes>(l: L, c: &mut DiffuseChunk, light_only: bool) {
+    let mut base = 0;
+    while base < c.len {
+        mesh_frames(l, c, base);
+        diffuse_lanes(l, c, base, light_only);
+        base += L::N;
+    }
+}
+
+/// One vector of the chunk's lanes, from `base`: `PathState::scatter` for a Lambertian BSDF.
+#[inline(always)]
+fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, light_only: bool) {
+    let zero = l.splat(0.0);
+    let one = l.splat(1.0);
+    let inv_pi = l.splat(INV_PI);
+    let dir = load3(l, &c.dir, base);
+    let p = load3(l, &c.p, base);
+    let ng = load3(l, &c.ng, base);
+    let n = load3(l, &c.n, base);
+    let refl = load3(l, &c.reflectance, base);
+    let thr = load3(l, &c.throughput, base);
+    // `frame.to_local(-ray.dir).z`: the Lambertian BSDF reads only the normal component.
+    let wo_z = dot(l, V3 { x: l.neg(dir.x), y: l.neg(dir.y), z: l.neg(dir.z) }, n);
+    let wo_below = l.le(wo_z, zero);
+
+    // Next-event estimation: `Diffuse::eval` and `pdf` towards the light, the MIS weight,
+    // the contribution and the shadow ray.
+    let light_wi = load3(l, &c.light_wi, base);
+    let wi_z = dot(l, light_wi, n);
+    let black = l.or(wo_below, l.le(wi_z, zero));
+    let k = l.mul(inv_pi, wi_z);
+    let f = V3 {
+        x: l.select(black, zero, l.mul(refl.x, k)),
+        y: l.select(black, zero, l.mul(refl.y, k)),
+        z: l.select(black, zero, l.mul(refl.z, k)),
+    };
+    // `cosine_hemisphere_pdf(wi.z)`: `wi.z.max(0.0)`, where `Lanes::max` agrees (0 on NaN).
+    let bsdf_pdf = l.select(black, zero, l.mul(l.max(wi_z, zero), inv_pi));
+    let f_black = l.and(l.and(l.eq(f.x, zero), l.eq(f.y, zero)), l.eq(f.z, zero));
+    let light_pdf = l.load(&c.light_pdf[base..]);
+    // `power_heuristic(light_pdf, bsdf_pdf)`.
+    let a = l.mul(light_pdf, light_pdf);
+    let b = l.mul(bsdf_pdf, bsdf_pdf);
+    let sum = l.add(a, b);
+    let heuristic = l.select(l.eq(a, l.splat(f32::INFINITY)), one, l.select(l.eq(sum, zero), zero, l.div(a, sum)));
+    let delta = l.gt(l.load(&c.light_delta[base..]), zero);
+    let mis = if light_only { one } else { l.select(delta, one, heuristic) };
+    let has_light = l.gt(l.load(&c.has_light[base..]), zero);
+    let shadow = l.and_not(has_light, f_black);
+    let radiance = load3(l, &c.light_radiance, base);
+    store3(l, mul3(l, mul3(l, thr, f), radiance), &mut c.contribution, base);
+    l.store(mis, &mut c.mis_weight[base..]);
+    l.store(l.select(shadow, one, zero), &mut c.shadow[base..]);
+    // `shadow_ray(si, ls.wi, ls.dist)`.
+    let dist = l.load(&c.light_dist[base..]);
+    let o = offset_origin(l, p, ng, light_wi);
+    let to_target = sub3(l, add3(l, p, scale(l, light_wi, dist)), o);
+    let len = l.sqrt(dot(l, to_target, to_target));
+    let toward = scale(l, to_target, l.div(one, len));
+    let finite = l.lt(l.abs(dist), l.splat(f32::INFINITY));
+    store3(l, o, &mut c.shadow_origin, base);
+    store3(l, select3(l, finite, toward, light_wi), &mut c.shadow_dir, base);
+    let t_max = l.mul(len, l.splat(1.0 - 1e-4));
+    l.store(l.select(finite, t_max, l.splat(f32::INFINITY)), &mut c.shadow_t_max[base..]);
+
+    // `Diffuse::sample`: `cosine_hemisphere(u)` by `concentric_disk`, in its operations.
+    let u0 = l.load(&c.u[0][base..]);
+    let u1 = l.load(&c.u[1][base..]);
+    let two = l.splat(2.0);
+    let qa = l.sub(l.mul(two, u0), one);
+    let qb = l.sub(l.mul(two, u1), one);
+    let around_y = l.le(l.abs(qa), l.abs(qb));
+    let r = l.select(around_y, qb, qa);
+    let q = l.select(around_y, qa, qb);
+    let centre = l.eq(r, zero);
+    let (sin_t, cos_t) = sin_cos_quarter(l, l.mul(l.splat(PI / 4.0), l.div(q, r)));
+    let dx = l.select(centre, zero, l.mul(r, l.select(around_y, sin_t, cos_t)));
+    let dy = l.select(centre, zero, l.mul(r, l.select(around_y, cos_t, sin_t)));
+    // `(1 - x² - y²).max(0.0)`: never -0.0 nor NaN for a sample in the square, where
+    // `Lanes::max` and `f32::max` agree.
+    let z = l.sqrt(l.max(l.sub(l.sub(one, l.mul(dx, dx)), l.mul(dy, dy)), zero));
+    let refl_black = l.and(l.and(l.eq(refl.x, zero), l.eq(refl.y, zero)), l.eq(refl.z, zero));
+    let sampled = l.and_not(l.and_not(l.not(wo_below), l.le(z, zero)), refl_black);
+    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
+    l.store(l.mul(l.max(z, zero), inv_pi), &mut c.pdf[base..]);
+    // `frame.to_world(wi)`, then `spawn_ray`.
+    let s = load3(l, &c.s, base);
+    let t = load3(l, &c.t, base);
+    let wi = add3(l, add3(l, scale(l, s, dx), scale(l, t, dy)), scale(l, n, z));
+    store3(l, wi, &mut c.next_dir, base);
+    store3(l, offset_origin(l, p, ng, wi), &mut c.next_origin, base);
+}
+
+/// For the lanes of untransformed meshes: `World::interaction`'s geometric normal and
+/// shading frame (interpolated normals, dp/du from the uvs), then `shading`'s turn of a
+/// two-sided material's frame towards the viewer, written to the `ng`, `n`, `s`, `t` columns;
+/// the other lanes keep theirs.
+#[inline(always)]
+fn mesh_frames<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize) {
+    let zero = l.splat(0.0);
+    let yes = |col: &Column| l.gt(l.load(&col[base..]), zero);
+    let from_mesh = yes(&c.from_mesh);
+    if l.bits(from_mesh) == 0 {
+        return;
+    }
+    let [a, b, cc] = c.corners.each_ref().map(|k| load3(l, k, base));
+    let [b0, b1, b2] = [0, 1, 2].map(|k| l.load(&c.bary[k][base..]));
+    let e1 = sub3(l, b, a);
+    let e2 = sub3(l, cc, a);
+    let ng_obj = cross(l, e1, e2);
+    // dp/du: from the uvs (`triangle_dpduv`), else the edge b - a.
+    let [t0, t1, t2] = c.uvs.each_ref().map(|uv| (l.load(&uv[0][base..]), l.load(&uv[1][base..])));
+    let (du0, dv0) = (l.sub(t1.0, t0.0), l.sub(t1.1, t0.1));
+    let (du1, dv1) = (l.sub(t2.0, t0.0), l.sub(t2.1, t0.1));
+    let det = l.sub(l.mul(du0, dv1), l.mul(dv0, du1));
+    let inv = l.div(l.splat(1.0), det);
+    let dpdu_uv = scale(l, sub3(l, scale(l, e1, dv1), scale(l, e2, dv0)), inv);
+    let dpdv_uv = scale(l, sub3(l, scale(l, e2, du0), scale(l, e1, du1)), inv);
+    let uv_ok = l.and(l.ne(det, zero), l.and(finite3(l, dpdu_uv), finite3(l, dpdv_uv)));
+    let (fallback_s, _) = frame_from_normal(l, normalize(l, ng_obj));
+    let dpdu_mesh = select3(l, uv_ok, dpdu_uv, fallback_s);
+    let dpdu = select3(l, yes(&c.has_uvs), dpdu_mesh, e1);
+    // The geometric normal, and the shading normal: the interpolated one where the mesh
+    // has normals and it is not zero, else the geometric one; the geometric one again where
+    // that is not finite.
+    let flip = yes(&c.flip_normals);
+    let ng_unit = normalize(l, ng_obj);
+    let ng = select3(l, flip, neg3(l, ng_unit), ng_unit);
+    let [n0, n1, n2] = c.normals.each_ref().map(|k| load3(l, k, base));
+    let ns = add3(l, add3(l, scale(l, n0, b0), scale(l, n1, b1)), scale(l, n2, b2));
+    let ns_unit = normalize(l, ns);
+    let ns_unit = select3(l, flip, neg3(l, ns_unit), ns_unit);
+    let use_ns = l.and(yes(&c.has_normals), l.gt(dot(l, ns, ns), zero));
+    let n_shading = select3(l, use_ns, ns_unit, ng);
+    let n_shading = select3(l, finite3(l, n_shading), n_shading, ng);
+    // `Frame::from_normal_tangent(n_shading, dpdu)`.
+    let s_raw = sub3(l, dpdu, scale(l, n_shading, dot(l, n_shading, dpdu)));
+    let len2 = dot(l, s_raw, s_raw);
+    let tangent_ok =
+        l.and(l.gt(len2, l.mul(l.splat(1e-20), dot(l, dpdu, dpdu))), l.lt(l.abs(len2), l.splat(f32::INFINITY)));
+    let s_unit = scale(l, s_raw, l.div(l.splat(1.0), l.sqrt(len2)));
+    let (basis_s, basis_t) = frame_from_normal(l, n_shading);
+    let s = select3(l, tangent_ok, s_unit, basis_s);
+    let t = select3(l, tangent_ok, cross(l, n_shading, s_unit), basis_t);
+    // `shading`: a two-sided material's frame faces the viewer (`-ray.dir`).
+    let dir = load3(l, &c.dir, base);
+    let facing_away = l.lt(dot(l, n_shading, neg3(l, dir)), zero);
+    let turn = l.and(yes(&c.two_sided), facing_away);
+    let n = select3(l, turn, neg3(l, n_shading), n_shading);
+    let keep = |new: V3<L::F>, col: &Column3| select3(l, from_mesh, new, load3(l, col, base));
+    let (ng, n, s, t) = (keep(ng, &c.ng), keep(n, &c.n), keep(s, &c.s), keep(t, &c.t));
+    store3(l, ng, &mut c.ng, base);
+    store3(l, n, &mut c.n, base);
+    store3(l, s, &mut c.s, base);
+    store3(l, t, &mut c.t, base);
+}
+
+/// `warp::sin_cos_quarter`, in its operations and constants.
+#[inline(always)]
+pub(super) fn sin_cos_quarter<L: Lanes>(l: L, t: L::F) -> (L::F, L::F) {
+    let c = |x: f32| l.splat(x);
+    let t2 = l.mul(t, t);
+    let sin_poly = l.add(c(1.0 / 120.0), l.mul(t2, l.add(c(-1.0 / 5040.0), l.mul(t2, c(1.0 / 362_880.0)))));
+    let sin = l.mul(t, l.add(c(1.0), l.mul(t2, l.add(c(-1.0 / 6.0), l.mul(t2, sin_poly)))));
+    let cos_inner = l.add(c(1.0 / 40_320.0), l.mul(t2, c(-1.0 / 3_628_800.0)));
+    let cos_mid = l.add(c(1.0 / 24.0), l.mul(t2, l.add(c(-1.0 / 720.0), l.mul(t2, cos_inner))));
+    let cos = l.add(c(1.0), l.mul(t2, l.add(c(-0.5), l.mul(t2, cos_mid))));
+    (sin, cos)
+}
