@@ -190,6 +190,16 @@ pub struct WideStats {
 /// `ray.t_max` on a hit and say whether there was one. A trait rather than a closure so that
 /// implementations can be `#[inline(always)]`: a call per leaf would spill the vector
 /// registers that hold the ray.
+///
+/// **The tie rule.** Every closest-hit kernel (single ray, batch, packet, the binary
+/// reference and brute force) answers with the hit of smallest `(t, primitive)`: the nearest,
+/// and among hits at exactly the same `t` (a ray through a shared edge or vertex, coincident
+/// triangles) the lowest primitive number, so that the answer does not depend on the order
+/// leaves are visited in. Implementations keep it by setting `ray.t_max` to the next float
+/// above the best `t` (so hits at an equal `t` are still reported by tests that accept
+/// `t < t_max`, and boxes entered at that `t` are not culled) and comparing `(t, primitive)`
+/// when they take a hit. Across a scene's instances the order is `(t, instance, primitive)`
+/// (`World::intersect`).
 pub trait ClosestLeaf {
     fn test(&mut self, first: u32, count: u32, ray: &mut Ray) -> bool;
 

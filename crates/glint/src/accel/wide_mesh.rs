@@ -32,8 +32,13 @@ unsafe fn leaf_blocks(blocks: &[Tri4], first: u32, count: u32) -> &[Tri4] {
 
 /// Closest hit among leaves' blocks of four, tested two blocks at a time (one AVX2 test;
 /// four blocks in one 16-lane AVX-512 test were slower, see BENCHMARKS.md).
-/// Testing a pair and taking its nearest lane, the first among equals, is what testing the
-/// two blocks in turn with a shrinking interval gives, so the hit is the same bits.
+///
+/// The tie rule ([`ClosestLeaf`]): the hit kept is the smallest `(t, triangle)`. Once there
+/// is a best hit at `t`, the ray's `t_max` is the next float above `t`, so the kernels (which
+/// accept `t' < t_max`) report exactly the hits at `t' <= t`, and a hit at an equal `t`
+/// replaces the best only with a lower triangle number. Testing a pair and taking its
+/// smallest `(t, triangle)` lane is then what testing the two blocks in turn gives, and the
+/// answer does not depend on the order leaves are visited in.
 struct Closest<'a, S> {
     blocks: &'a [Tri4],
     tr: TriRay,
@@ -44,9 +49,18 @@ struct Closest<'a, S> {
 impl<'a, S: Isa> Closest<'a, S> {
     #[inline(always)]
     fn take<const N: usize>(&mut self, h: &TriHits<N>, prim: impl Fn(usize) -> u32, r: &mut Ray) -> bool {
-        let Some(lane) = h.nearest() else { return false };
-        r.t_max = h.t[lane];
-        self.best = Some((prim(lane), TriangleHit { t: h.t[lane], b1: h.b1[lane], b2: h.b2[lane] }));
+        let Some(lane) = h.nearest(&prim) else { return false };
+        let (t, p) = (h.t[lane], prim(lane));
+        if let Some((bp, bh)) = self.best {
+            // `t <= bh.t` by the kernels' bound; an equal `t` wins with a lower number only.
+            if t > bh.t || (t == bh.t && p >= bp) {
+                return false;
+            }
+        }
+        // The kernels accept only `t > t_min && t < t_max`, so `t` is finite and below
+        // `r.t_max`: its next float up is at most `r.t_max`, and the interval only shrinks.
+        r.t_max = t.next_up();
+        self.best = Some((p, TriangleHit { t, b1: h.b1[lane], b2: h.b2[lane] }));
         true
     }
 
@@ -265,6 +279,11 @@ impl<const W: usize> TriangleWideBvh<W> {
     unsafe fn intersect_generic<S: Isa>(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
         let mut leaf = Closest::<S> { blocks: &self.blocks, tr: TriRay::new(ray), best: None, isa: PhantomData };
         self.tree.traverse::<S>(ray, &mut leaf);
+        // Traversal left `t_max` just above the hit (see `Closest`): shortened to the hit, as
+        // callers expect.
+        if let Some((_, h)) = &leaf.best {
+            ray.t_max = h.t;
+        }
         leaf.best
     }
 

@@ -398,7 +398,14 @@ impl World {
     }
 
     /// The closest hit among the instances outside the flat BVH, or `best` (the flat BVH's,
-    /// whose distance `r.t_max` already is) when none is nearer.
+    /// whose distance `r.t_max` already is) when none comes first.
+    ///
+    /// The order of hits (the tie rule, see `accel::wide::ClosestLeaf`): smallest
+    /// `(t, instance, prim)`, so that which instance or primitive a ray through a shared edge
+    /// or coincident surfaces reports does not depend on the order anything is visited in.
+    /// `r.t_max` stays the best `t` (it culls the top-level tree, whose box test keeps boxes
+    /// entered at exactly that `t`); each instance is asked with the next float up as its
+    /// bound (see `intersect_instance`) and answers with its own smallest `(t, prim)`.
     #[inline]
     fn intersect_unflattened(&self, r: &mut Ray, mut best: Option<Hit>) -> Option<Hit> {
         if !self.top.has_unflattened() {
@@ -406,19 +413,38 @@ impl World {
         }
         self.top.traverse(r, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
-            if let Some(h) = self.intersect_instance(inst, r) {
-                r.t_max = h.t;
-                best = Some(Hit { instance: inst_idx, ..h });
-                true
-            } else {
-                false
+            let found = self.intersect_instance(inst, r, best.is_some());
+            match found {
+                Some(h) if best.is_none_or(|b| hit_before(h.t, inst_idx, h.prim, &b)) => {
+                    r.t_max = h.t;
+                    best = Some(Hit { instance: inst_idx, ..h });
+                    true
+                }
+                _ => false,
             }
         });
         best
     }
 
+    /// One instance's closest hit within `r`'s interval, its own smallest `(t, prim)`; with
+    /// `tie` (a best hit at `r.t_max` exists), hits at exactly `r.t_max` count too.
+    ///
+    /// Signed distance grids and curves are asked with `r` as it is: their root searches use
+    /// the interval's end, so a bound one float higher could move their hits' bits. Their ties
+    /// with another instance at exactly the same `t` keep the instance found first (rare, and
+    /// so not yet order-independent); their own primitives follow the rule (curves compare
+    /// `(t, point)`; grids' voxels are in their own BVH's order, also not yet).
     #[inline]
-    fn intersect_instance(&self, inst: &Instance, r: &Ray) -> Option<Hit> {
+    fn intersect_instance(&self, inst: &Instance, r: &Ray, tie: bool) -> Option<Hit> {
+        let widened;
+        let r = match inst.shape {
+            ShapeRef::Mesh(_) | ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) if tie => {
+                // `r.t_max` is a hit's `t`, finite, so the next float up is a valid bound.
+                widened = Ray { t_max: r.t_max.next_up(), ..*r };
+                &widened
+            }
+            _ => r,
+        };
         match inst.shape {
             ShapeRef::Mesh(m) => {
                 let mesh = &self.meshes[m as usize];
@@ -749,6 +775,13 @@ impl World {
 
 /// The traversal hit of a curve: `prim` its segment's first control point, `b1` the
 /// segment parameter.
+/// Whether a hit at `t` on `(instance, prim)` comes before `best` in the order of closest
+/// hits: smallest `(t, instance, prim)`.
+#[inline(always)]
+fn hit_before(t: f32, instance: u32, prim: u32, best: &Hit) -> bool {
+    t < best.t || (t == best.t && (instance, prim) < (best.instance, best.prim))
+}
+
 fn curve_hit(h: CurveHit, instance: u32) -> Hit {
     Hit { t: h.t, instance, prim: h.point, b1: h.v, b2: 0.0 }
 }
