@@ -133,6 +133,13 @@ fn every_mesh_kernel_takes_the_smallest_t_and_triangle() {
             for ((ray, (w, _)), h) in rays.iter().zip(&want).zip(&hits) {
                 assert_eq!(bits(h), bits(w), "{accel:?} {path:?} batch, ray {ray:?}");
             }
+            for split in [0, glint::accel::SINGLE_BELOW, 17] {
+                let mut hits = vec![None; rays.len()];
+                m.intersect_packets_with(&rays, &mut hits, path, split);
+                for ((ray, (w, _)), h) in rays.iter().zip(&want).zip(&hits) {
+                    assert_eq!(bits(h), bits(w), "{accel:?} {path:?} packets split {split}, ray {ray:?}");
+                }
+            }
         }
     }
     // Vertical rays hit the flat grid at exactly t = 5 from every triangle around the target.

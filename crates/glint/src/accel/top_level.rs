@@ -134,6 +134,27 @@ impl TopLevelBvh {
         }
     }
 
+    /// [`TopLevelBvh::intersect_flat`] of many rays, in packets
+    /// (`TriangleWideBvh::intersect_packets`, bit-identical answers); `hits[i]` is for
+    /// `rays[i]`, which are not shortened.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_flat_packets(&self, rays: &[Ray], hits: &mut [Option<(u32, u32, TriangleHit)>]) {
+        assert_eq!(rays.len(), hits.len(), "intersect_flat_packets: one hit slot per ray");
+        let Some(flat) = &self.flat else {
+            hits.fill(None);
+            return;
+        };
+        let mut global = vec![None; rays.len()];
+        flat.intersect_packets(rays, &mut global, SimdPath::detect());
+        for (out, g) in hits.iter_mut().zip(global) {
+            *out = g.map(|(g, h)| {
+                let k = self.flat_offsets.partition_point(|&o| o <= g) - 1;
+                (self.flat_instances[k], g - self.flat_offsets[k], h)
+            });
+        }
+    }
+
     /// [`TopLevelBvh::occluded_flat`] of many rays, in packets (`TriangleWideBvh::occluded_packets`).
     ///
     /// Panics if the slices differ in length.

@@ -363,11 +363,30 @@ impl<const W: usize> WideBvh<W> {
         if self.root == EMPTY_CHILD {
             return false;
         }
-        let nr = NodeRay::new(ray);
+        // SAFETY: the root of a non-empty tree; `S` is the caller's.
+        unsafe { self.traverse_from::<S>(self.root, ray, &NodeRay::new(ray), leaf) }
+    }
+
+    /// Closest-hit traversal of the subtree at `start` (the packet traversal's single-ray
+    /// fall-back starts below the root).
+    ///
+    /// # Safety
+    /// `S` must be available on this CPU; `start` must be the root of a non-empty tree or a
+    /// node reference from a slot whose box the ray passes; `nr` must be `NodeRay::new(ray)`
+    /// (of the ray's origin and direction, which traversal does not change).
+    #[inline(always)]
+    pub(super) unsafe fn traverse_from<S: Isa>(
+        &self,
+        start: u32,
+        ray: &mut Ray,
+        nr: &NodeRay,
+        leaf: &mut impl ClosestLeaf,
+    ) -> bool {
+        let nr = *nr;
         let nodes: &[WideNode<W>] = &self.nodes;
         let mut stack: [MaybeUninit<(u32, f32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut sp = 0usize;
-        let mut cur = self.root;
+        let mut cur = start;
         let mut found = false;
         loop {
             if cur & LEAF_BIT == 0 {

@@ -46,7 +46,20 @@ struct Closest<'a, S> {
     isa: PhantomData<S>,
 }
 
+// By hand: a derive would ask `S: Copy`.
+impl<S> Clone for Closest<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for Closest<'_, S> {}
+
 impl<'a, S: Isa> Closest<'a, S> {
+    #[inline(always)]
+    fn new(blocks: &'a [Tri4], ray: &Ray) -> Closest<'a, S> {
+        Closest { blocks, tr: TriRay::new(ray), best: None, isa: PhantomData }
+    }
+
     #[inline(always)]
     fn take<const N: usize>(&mut self, h: &TriHits<N>, prim: impl Fn(usize) -> u32, r: &mut Ray) -> bool {
         let Some(lane) = h.nearest(&prim) else { return false };
@@ -75,7 +88,8 @@ impl<'a, S: Isa> Closest<'a, S> {
                 continue;
             };
             // SAFETY: `S` is available (the only callers are `intersect_generic`'s and
-            // `intersect_batch_generic`'s, which require it); the kernel reads only `a`, `b`
+            // `intersect_batch_generic`'s and `intersect_packets_generic`'s, which require
+            // it); the kernel reads only `a`, `b`
             // and `self.tr`.
             let h = unsafe { S::tri8(a, b, &self.tr, r.t_min, r.t_max) };
             hit |= self.take(&h, |lane| if lane < 4 { a.prim[lane] } else { b.prim[lane - 4] }, r);
@@ -430,6 +444,85 @@ impl<const W: usize> TriangleWideBvh<W> {
             let bits = unsafe { self.tree.occluded_packet::<S, L, _>(l, r, &leaf, single_below) };
             for (i, b) in b.iter_mut().enumerate() {
                 *b = bits >> i & 1 == 1;
+            }
+        }
+    }
+
+    /// Closest hits of many rays in packets (see `packet.rs`): `hits[i]` is
+    /// [`TriangleWideBvh::intersect`] of `rays[i]`, bit for bit (the tie rule makes the
+    /// answer independent of the packet's visit order); sixteen rays per packet on the
+    /// AVX-512 path, eight on AVX2, one on the others. The rays are not shortened.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_packets(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>], path: SimdPath) {
+        self.intersect_packets_split(rays, hits, path, SINGLE_BELOW);
+    }
+
+    /// [`TriangleWideBvh::intersect_packets`] with rays leaving the packet where fewer than
+    /// `single_below` are active at a node (0: never), for tests and measurements; the
+    /// answers are the same for every value.
+    pub fn intersect_packets_split(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        path: SimdPath,
+        single_below: u32,
+    ) {
+        assert_eq!(rays.len(), hits.len(), "intersect_packets: one hit slot per ray");
+        let s = single_below;
+        // SAFETY (every arm): each path runs only where the CPU has it.
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 if path.is_available() => unsafe { self.intersect_packets_avx2(rays, hits, s) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 if path.is_available() => unsafe { self.intersect_packets_avx512(rays, hits, s) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.intersect_packets_generic::<Sse, One>(One, rays, hits, s) },
+            _ => unsafe { self.intersect_packets_generic::<Scalar, One>(One, rays, hits, s) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn intersect_packets_avx2(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>], single_below: u32) {
+        // SAFETY: this path runs only where AVX2 is available (`intersect_packets`).
+        let l = unsafe { Avx2x8::new_unchecked() };
+        self.intersect_packets_generic::<Avx2, Avx2x8>(l, rays, hits, single_below)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    unsafe fn intersect_packets_avx512(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        single_below: u32,
+    ) {
+        // SAFETY: the AVX-512 path requires AVX-512F (`SimdPath::is_available`).
+        let l = unsafe { Avx512x16::new_unchecked() };
+        self.intersect_packets_generic::<Avx512, Avx512x16>(l, rays, hits, single_below)
+    }
+
+    #[inline(always)]
+    unsafe fn intersect_packets_generic<S: Isa, L: Lanes>(
+        &self,
+        l: L,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        single_below: u32,
+    ) {
+        let blocks: &[Tri4] = &self.blocks;
+        for (r, h) in rays.chunks(L::N).zip(hits.chunks_mut(L::N)) {
+            let mut local = [r[0]; MAX_LANES];
+            local[..r.len()].copy_from_slice(r);
+            let mut leaves = [Closest::<S>::new(blocks, &r[0]); MAX_LANES];
+            for (leaf, ray) in leaves.iter_mut().zip(r).skip(1) {
+                *leaf = Closest::new(blocks, ray);
+            }
+            // SAFETY: `S` is available (this function's callers).
+            unsafe { self.tree.intersect_packet::<S, L, _>(l, &mut local[..r.len()], &mut leaves, single_below) };
+            for (h, leaf) in h.iter_mut().zip(&leaves) {
+                *h = leaf.best;
             }
         }
     }

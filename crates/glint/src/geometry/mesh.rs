@@ -256,6 +256,23 @@ impl TriangleMesh {
         }
     }
 
+    /// Closest hits of many rays in packets (`TriangleWideBvh::intersect_packets`): `hits[i]`
+    /// is `intersect_with(rays[i], path)`, bit for bit; rays leave a packet where fewer than
+    /// `single_below` are active. Panics if the slices differ in length.
+    pub fn intersect_packets_with(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        path: SimdPath,
+        single_below: u32,
+    ) {
+        match &self.wide {
+            WideTris::W8(w) => w.intersect_packets_split(rays, hits, path, single_below),
+            WideTris::W4(w) => w.intersect_packets_split(rays, hits, path, single_below),
+            WideTris::None => self.intersect_batch_with(rays, hits, path),
+        }
+    }
+
     /// Closest hit through the binary BVH: the reference implementation. Of hits at equal
     /// `t`, the lowest triangle number (the tie rule, see `accel::wide::ClosestLeaf`).
     #[inline]

@@ -49,7 +49,8 @@ pub enum BatchTraversal {
     OneByOne,
     /// Several traversals in flight per thread, interleaved ([`World::intersect_batch`]).
     Interleaved,
-    /// Closest hits one by one, occlusion in packets of rays ([`World::occluded_packets`]).
+    /// Closest hits and occlusion in packets of rays ([`World::intersect_packets`],
+    /// [`World::occluded_packets`]).
     Packets,
 }
 
@@ -347,11 +348,29 @@ impl World {
         }
     }
 
+    /// Closest hits of many rays, the flat BVH traced in packets of rays: `hits[i]` is
+    /// [`World::intersect`] of `rays[i]`, bit for bit (the tie rule makes the answer
+    /// independent of visit order); the instances outside the flat BVH are then traced one
+    /// ray at a time.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_packets(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "intersect_packets: one hit slot per ray");
+        let mut flat = vec![None; rays.len()];
+        self.top.intersect_flat_packets(rays, &mut flat);
+        for ((ray, f), out) in rays.iter().zip(flat).zip(hits.iter_mut()) {
+            let best = f.map(|(instance, prim, h)| Hit { t: h.t, instance, prim, b1: h.b1, b2: h.b2 });
+            let mut r = Ray { t_max: best.map_or(ray.t_max, |h| h.t), ..*ray };
+            *out = self.intersect_unflattened(&mut r, best);
+        }
+    }
+
     /// Closest hits of many rays traced as `traversal` says (same answers either way).
     pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>], traversal: BatchTraversal) {
         match traversal {
             BatchTraversal::Interleaved => self.intersect_batch(rays, hits),
-            BatchTraversal::OneByOne | BatchTraversal::Packets => {
+            BatchTraversal::Packets => self.intersect_packets(rays, hits),
+            BatchTraversal::OneByOne => {
                 assert_eq!(rays.len(), hits.len(), "intersect_many: one hit slot per ray");
                 for (r, h) in rays.iter().zip(hits.iter_mut()) {
                     *h = self.intersect(r);
