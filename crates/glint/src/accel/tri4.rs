@@ -79,16 +79,20 @@ impl<const N: usize> TriHits<N> {
     #[inline(always)]
     pub fn nearest(&self, prim: impl Fn(usize) -> u32) -> Option<usize> {
         let mut m = self.mask;
-        let mut best: Option<(usize, u32)> = None;
+        if m == 0 {
+            return None;
+        }
+        let mut best = m.trailing_zeros() as usize;
+        m &= m - 1;
         while m != 0 {
             let i = m.trailing_zeros() as usize;
             m &= m - 1;
-            let p = prim(i);
-            if best.is_none_or(|(b, bp)| self.t[i] < self.t[b] || (self.t[i] == self.t[b] && p < bp)) {
-                best = Some((i, p));
+            // Triangle numbers are looked up on exact ties only (rare).
+            if self.t[i] < self.t[best] || (self.t[i] == self.t[best] && prim(i) < prim(best)) {
+                best = i;
             }
         }
-        best.map(|(i, _)| i)
+        Some(best)
     }
 }
 

@@ -46,6 +46,17 @@ struct Closest<'a, S> {
     isa: PhantomData<S>,
 }
 
+/// The next float above `t`, [`f32::next_up`] with the common case (a positive finite `t`,
+/// whose next float is one bit pattern up, `f32::MAX`'s being +inf) first.
+#[inline(always)]
+pub(crate) fn float_above(t: f32) -> f32 {
+    if t > 0.0 && t < f32::INFINITY {
+        f32::from_bits(t.to_bits() + 1)
+    } else {
+        t.next_up()
+    }
+}
+
 // By hand: a derive would ask `S: Copy`.
 impl<S> Clone for Closest<'_, S> {
     fn clone(&self) -> Self {
@@ -63,16 +74,17 @@ impl<'a, S: Isa> Closest<'a, S> {
     #[inline(always)]
     fn take<const N: usize>(&mut self, h: &TriHits<N>, prim: impl Fn(usize) -> u32, r: &mut Ray) -> bool {
         let Some(lane) = h.nearest(&prim) else { return false };
-        let (t, p) = (h.t[lane], prim(lane));
-        if let Some((bp, bh)) = self.best {
+        let t = h.t[lane];
+        if let Some((bp, bh)) = &self.best {
             // `t <= bh.t` by the kernels' bound; an equal `t` wins with a lower number only.
-            if t > bh.t || (t == bh.t && p >= bp) {
+            if !(t < bh.t || (t == bh.t && prim(lane) < *bp)) {
                 return false;
             }
         }
+        let p = prim(lane);
         // The kernels accept only `t > t_min && t < t_max`, so `t` is finite and below
         // `r.t_max`: its next float up is at most `r.t_max`, and the interval only shrinks.
-        r.t_max = t.next_up();
+        r.t_max = float_above(t);
         self.best = Some((p, TriangleHit { t, b1: h.b1[lane], b2: h.b2[lane] }));
         true
     }
