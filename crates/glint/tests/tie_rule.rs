@@ -126,7 +126,11 @@ fn every_mesh_kernel_takes_the_smallest_t_and_triangle() {
                 let mut r = *ray;
                 let got = m.intersect_with(&mut r, path);
                 assert_eq!(bits(&got), bits(w), "{accel:?} {path:?} single ray {ray:?}");
-                assert_eq!(r.t_max.to_bits(), w.map_or(ray.t_max, |(_, h)| h.t).to_bits(), "t_max shortened to the hit");
+                assert_eq!(
+                    r.t_max.to_bits(),
+                    w.map_or(ray.t_max, |(_, h)| h.t).to_bits(),
+                    "t_max shortened to the hit"
+                );
             }
             let mut hits = vec![None; rays.len()];
             m.intersect_batch_with(&rays, &mut hits, path);

@@ -23,8 +23,7 @@
 
 use super::simd::Isa;
 use super::wide::{
-    leaf_mask, leaf_range, AnyLeaf, ClosestLeaf, NodeRay, WideBvh, WideNode, EMPTY_CHILD, FAR_SCALE, LEAF_BIT,
-    STACK,
+    leaf_mask, leaf_range, AnyLeaf, ClosestLeaf, NodeRay, WideBvh, WideNode, EMPTY_CHILD, FAR_SCALE, LEAF_BIT, STACK,
 };
 use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::Ray;
