@@ -792,8 +792,6 @@ impl World {
     }
 }
 
-/// The traversal hit of a curve: `prim` its segment's first control point, `b1` the
-/// segment parameter.
 /// Whether a hit at `t` on `(instance, prim)` comes before `best` in the order of closest
 /// hits: smallest `(t, instance, prim)`.
 #[inline(always)]
@@ -801,6 +799,8 @@ fn hit_before(t: f32, instance: u32, prim: u32, best: &Hit) -> bool {
     t < best.t || (t == best.t && (instance, prim) < (best.instance, best.prim))
 }
 
+/// The traversal hit of a curve: `prim` its segment's first control point, `b1` the
+/// segment parameter.
 fn curve_hit(h: CurveHit, instance: u32) -> Hit {
     Hit { t: h.t, instance, prim: h.point, b1: h.v, b2: 0.0 }
 }
