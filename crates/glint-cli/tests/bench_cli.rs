@@ -75,6 +75,10 @@ fn bench_json_is_well_formed_and_hits_match_the_reference() {
             "batch_occluded_mrays_per_s",
             "batch_closest_speedup",
             "batch_occluded_speedup",
+            "packet_closest_mrays_per_s",
+            "packet_occluded_mrays_per_s",
+            "packet_closest_speedup",
+            "packet_occluded_speedup",
         ];
         for key in batch_keys {
             if batch {
@@ -87,11 +91,13 @@ fn bench_json_is_well_formed_and_hits_match_the_reference() {
         if batch {
             assert_eq!(j["batch_lanes"].as_u64(), Some(glint::accel::BATCH_LANES as u64));
             // The speedups are the ratios of the figures they sit beside.
-            for kind in ["closest", "occluded"] {
-                let ratio = j[format!("batch_{kind}_mrays_per_s")].as_f64().unwrap()
-                    / j[format!("{kind}_mrays_per_s")].as_f64().unwrap();
-                let speedup = j[format!("batch_{kind}_speedup")].as_f64().unwrap();
-                assert!((ratio / speedup - 1.0).abs() < 1e-9, "{kind}: {ratio} against {speedup}");
+            for api in ["batch", "packet"] {
+                for kind in ["closest", "occluded"] {
+                    let ratio = j[format!("{api}_{kind}_mrays_per_s")].as_f64().unwrap()
+                        / j[format!("{kind}_mrays_per_s")].as_f64().unwrap();
+                    let speedup = j[format!("{api}_{kind}_speedup")].as_f64().unwrap();
+                    assert!((ratio / speedup - 1.0).abs() < 1e-9, "{api} {kind}: {ratio} against {speedup}");
+                }
             }
         }
         for key in [

@@ -7,8 +7,9 @@
 //! reference binary BVH's; `occluded_batch` gives the single-ray occlusion answer. Batches of
 //! 0, 1, odd and large sizes (more rays than lanes, so lanes are refilled) and empty and
 //! one-leaf trees are covered, and hostile triangles (NaN, infinite) below `TriangleMesh`.
-//! Packet occlusion (`occluded_packets`) is held to the same single-ray answers, with rays
-//! leaving the packet never, at the default count, and always.
+//! Packet occlusion (`occluded_packets`) and packet closest hits (`intersect_packets`) are
+//! held to the same single-ray answers, with rays leaving the packet never, at the default
+//! count, and always.
 
 use glint::accel::{BuildOptions, Bvh, BvhSplit, SimdPath, TriangleHit, TriangleWideBvh, BATCH_LANES};
 use glint::geometry::{MeshAccel, TriangleMesh};
@@ -119,9 +120,28 @@ fn check_batch(mesh: &TriangleMesh, rays: &[Ray]) -> Result<(), TestCaseError> {
                 b
             })
             .collect();
+        let closest_packets: Vec<Vec<Hit>> = PACKET_SPLITS
+            .iter()
+            .map(|&split| {
+                let mut h: Vec<Hit> = vec![Some((7, TriangleHit { t: -2.0, b1: 0.0, b2: 0.0 })); rays.len()];
+                mesh.intersect_packets_with(rays, &mut h, path, split);
+                h
+            })
+            .collect();
         for (i, ray) in rays.iter().enumerate() {
             for (b, split) in packets.iter().zip(PACKET_SPLITS) {
                 prop_assert_eq!(b[i], blocked[i], "{} packets split below {}: ray {} {:?}", path, split, i, ray);
+            }
+            for (h, split) in closest_packets.iter().zip(PACKET_SPLITS) {
+                prop_assert_eq!(
+                    bits(&h[i]),
+                    bits(&hits[i]),
+                    "{} closest-hit packets split below {}: ray {} {:?}",
+                    path,
+                    split,
+                    i,
+                    ray
+                );
             }
             let single = mesh.intersect_with(&mut ray.clone(), path);
             prop_assert_eq!(bits(&hits[i]), bits(&single), "{} ray {} of {}: {:?}", path, i, rays.len(), ray);
@@ -206,6 +226,15 @@ proptest! {
                 w8.occluded_packets_split(&rays, &mut p8, path, 0);
                 prop_assert_eq!(&p4, &b4, "{} packets, wide4", path);
                 prop_assert_eq!(&p8, &b8, "{} packets, wide8", path);
+                for split in PACKET_SPLITS {
+                    let (mut c4, mut c8) = (vec![None; rays.len()], vec![None; rays.len()]);
+                    w4.intersect_packets_split(&rays, &mut c4, path, split);
+                    w8.intersect_packets_split(&rays, &mut c8, path, split);
+                    for i in 0..rays.len() {
+                        prop_assert_eq!(bits(&c4[i]), bits(&h4[i]), "{} closest packets, wide4, split {}", path, split);
+                        prop_assert_eq!(bits(&c8[i]), bits(&h8[i]), "{} closest packets, wide8, split {}", path, split);
+                    }
+                }
                 for (i, ray) in rays.iter().enumerate() {
                     prop_assert_eq!(bits(&h4[i]), bits(&w4.intersect(&mut ray.clone(), path)), "{} {:?}", path, ray);
                     prop_assert_eq!(bits(&h8[i]), bits(&w8.intersect(&mut ray.clone(), path)), "{} {:?}", path, ray);
@@ -261,6 +290,9 @@ fn empty_and_one_leaf_trees() {
         blocked.fill(true);
         empty.occluded_packets_with(&rays, &mut blocked, path, 0);
         assert!(blocked.iter().all(|&b| !b), "{path} packets");
+        hits.fill(Some((0, TriangleHit { t: 1.0, b1: 0.0, b2: 0.0 })));
+        empty.intersect_packets_with(&rays, &mut hits, path, 0);
+        assert!(hits.iter().all(|h| h.is_none()), "{path} closest-hit packets");
     }
     // One triangle: the root is a leaf.
     let one = mesh_from(&[(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)], &[], MeshAccel::Wide8);
@@ -282,6 +314,7 @@ fn empty_batch_touches_nothing() {
         mesh.intersect_batch_with(&[], &mut [], path);
         mesh.occluded_batch_with(&[], &mut [], path);
         mesh.occluded_packets_with(&[], &mut [], path, 0);
+        mesh.intersect_packets_with(&[], &mut [], path, 0);
     }
 }
 

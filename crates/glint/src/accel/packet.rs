@@ -14,10 +14,16 @@
 //! order nodes are visited in: a ray is reported blocked exactly when some leaf it reaches
 //! through boxes it passes holds a triangle it hits, the single-ray answer (the tests compare
 //! them ray by ray, special rays included).
+//!
+//! Closest-hit packets ([`WideBvh::intersect_packet`]) visit nodes in another order than a
+//! single ray does (children by the entry distance of the packet's first active ray), and
+//! each ray's `t_max` shrinks as its leaf tests find hits, culling the boxes it enters
+//! beyond. The tie rule (smallest `(t, primitive)`, see [`ClosestLeaf`]) makes a ray's answer
+//! independent of that order, so it is the single-ray answer bit for bit.
 
 use super::simd::Isa;
 use super::wide::{
-    leaf_mask, leaf_range, AnyLeaf, NodeRay, WideBvh, WideNode, EMPTY_CHILD, FAR_SCALE, LEAF_BIT, STACK,
+    leaf_mask, leaf_range, AnyLeaf, ClosestLeaf, NodeRay, WideBvh, WideNode, EMPTY_CHILD, FAR_SCALE, LEAF_BIT, STACK,
 };
 use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::Ray;
@@ -74,6 +80,13 @@ impl<L: Lanes> PacketRays<L> {
     /// The rays that pass child `c`'s box: per lane, the single-ray kernels' slab test.
     #[inline(always)]
     fn hits<const W: usize>(&self, l: L, node: &WideNode<W>, c: usize) -> u32 {
+        self.hits_near(l, node, c).0
+    }
+
+    /// [`PacketRays::hits`] and each lane's entry distance (what the single-ray kernels
+    /// keep in `dist` to cull the box later).
+    #[inline(always)]
+    fn hits_near<const W: usize>(&self, l: L, node: &WideNode<W>, c: usize) -> (u32, L::F) {
         // No closures here: a closure is compiled apart from the `#[target_feature]` caller,
         // and its intrinsics become calls.
         let mut near = [l.splat(0.0); 3];
@@ -86,7 +99,14 @@ impl<L: Lanes> PacketRays<L> {
         }
         let t_near = l.max(near[0], l.max(near[1], l.max(near[2], self.t_min)));
         let t_far = l.min(far[0], l.min(far[1], l.min(far[2], self.t_max)));
-        l.bits(l.le(t_near, l.mul(t_far, l.splat(FAR_SCALE))))
+        (l.bits(l.le(t_near, l.mul(t_far, l.splat(FAR_SCALE)))), t_near)
+    }
+
+    /// The lanes whose entry distance `t_near` is not beyond their (shortened) `t_max`: the
+    /// single-ray kernels' `dist <= t_max * FAR_SCALE` per lane (false for NaN).
+    #[inline(always)]
+    fn within(&self, l: L, t_near: L::F) -> u32 {
+        l.bits(l.le(t_near, l.mul(self.t_max, l.splat(FAR_SCALE))))
     }
 }
 
@@ -202,6 +222,153 @@ impl<const W: usize> WideBvh<W> {
                 let (c, m) = unsafe { stack.get_unchecked(sp).assume_init() };
                 if m & !blocked != 0 {
                     (cur, active) = (c, m & !blocked);
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Closest hits of `rays` (at most `L::N`) in a packet: `leaves[i]` is ray i's leaf
+    /// state (it records the hit, see [`ClosestLeaf`]) and `rays[i].t_max` shrinks as the
+    /// single-ray traversal's does; each ray ends with the hit [`WideBvh::traverse`] gives it,
+    /// bit for bit, by the tie rule (module doc). Rays leave the packet at nodes where fewer
+    /// than `single_below` are active.
+    ///
+    /// Panics if `rays` is empty, longer than `L::N` or than `leaves`.
+    ///
+    /// # Safety
+    /// `S` must be available on this CPU (see [`Isa`]).
+    #[inline(always)]
+    pub unsafe fn intersect_packet<S: Isa, L: Lanes, C: ClosestLeaf>(
+        &self,
+        l: L,
+        rays: &mut [Ray],
+        leaves: &mut [C],
+        single_below: u32,
+    ) {
+        let n = rays.len();
+        assert!(n >= 1 && n <= L::N && leaves.len() >= n, "intersect_packet: 1 to {} rays, a leaf each", L::N);
+        let root = self.root();
+        if root == EMPTY_CHILD {
+            return;
+        }
+        let mut nrs = [NodeRay::new(&rays[0]); MAX_LANES];
+        for (nr, ray) in nrs.iter_mut().zip(rays.iter()).skip(1) {
+            *nr = NodeRay::new(ray);
+        }
+        let nrs = &nrs[..n];
+        let mut packet = PacketRays::<L>::new(l, nrs, rays);
+        // The lanes' `t_max`, reloaded into `packet` after leaf tests shorten some.
+        let mut t_max = [0.0f32; MAX_LANES];
+        l.store(packet.t_max, &mut t_max);
+        let all = u32::MAX >> (32 - n);
+        let nodes: &[WideNode<W>] = self.nodes();
+        // (node, its active rays, their entry distances into its box).
+        let mut stack: [MaybeUninit<(u32, u32, L::F)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
+        let mut sp = 0usize;
+        let (mut cur, mut active) = (root, all);
+        loop {
+            if cur & LEAF_BIT != 0 {
+                // The root as a leaf (see `occluded_packet`).
+                for i in lanes(active) {
+                    if !nrs[i].t_min.is_nan() {
+                        let (first, count) = leaf_range(cur);
+                        leaves[i].test(first, count, &mut rays[i]);
+                    }
+                }
+            } else if active.count_ones() < single_below {
+                for i in lanes(active) {
+                    // SAFETY: `cur` is a node index that ray i's slab test passed (the root, or
+                    // a child reference followed below), `S` is available (this function's
+                    // contract), and `nrs[i]` is ray i's.
+                    unsafe { self.traverse_from::<S>(cur, &mut rays[i], &nrs[i], &mut leaves[i]) };
+                    t_max[i] = rays[i].t_max;
+                }
+                packet.t_max = l.load(&t_max);
+            } else {
+                // SAFETY: as in `occluded_packet`: `cur` is the root or a node reference from a
+                // slot that some active ray's slab test passed.
+                let node = unsafe { nodes.get_unchecked(cur as usize) };
+                let leaf_bits = leaf_mask(node);
+                let mut passed = [0u32; W];
+                let mut near = [l.splat(0.0); W];
+                let mut lane_leaves = [0u32; MAX_LANES];
+                let mut any_leaf = false;
+                for c in 0..W {
+                    // `collapse` fills a node's slots in order: the first empty one ends them.
+                    if node.children[c] == EMPTY_CHILD {
+                        break;
+                    }
+                    let (bits, t_near) = packet.hits_near(l, node, c);
+                    passed[c] = bits & active;
+                    near[c] = t_near;
+                    if leaf_bits >> c & 1 != 0 {
+                        for i in lanes(passed[c]) {
+                            lane_leaves[i] |= 1 << c;
+                            any_leaf = true;
+                        }
+                    }
+                }
+                // Leaves first, as the single-ray traversal does, each ray's through its own
+                // leaf state; a hit shortens the ray and culls the subtrees behind it.
+                if any_leaf {
+                    for i in lanes(active) {
+                        if lane_leaves[i] != 0 {
+                            leaves[i].test_leaves(&node.children, lane_leaves[i], &mut rays[i]);
+                            t_max[i] = rays[i].t_max;
+                        }
+                    }
+                    packet.t_max = l.load(&t_max);
+                }
+                // Interior children in the order of the first active ray's entry distances,
+                // nearest on top (any order gives the same answers).
+                let key_lane = active.trailing_zeros() as usize;
+                let mut order = [(0u32, 0.0f32); W];
+                let mut k = 0usize;
+                let mut key = [0.0f32; MAX_LANES];
+                for c in lanes(!leaf_bits & (u32::MAX >> (32 - W))) {
+                    let m = if any_leaf { passed[c] & packet.within(l, near[c]) } else { passed[c] };
+                    if m == 0 {
+                        continue;
+                    }
+                    passed[c] = m;
+                    l.store(near[c], &mut key);
+                    let d = key[key_lane];
+                    // Insertion by descending distance (NaN keys, of rays that do not pass,
+                    // compare false and stay where they are).
+                    let mut j = k;
+                    while j > 0 && order[j - 1].1 < d {
+                        order[j] = order[j - 1];
+                        j -= 1;
+                    }
+                    order[j] = (c as u32, d);
+                    k += 1;
+                }
+                if k > 0 {
+                    for &(c, _) in &order[..k - 1] {
+                        let c = c as usize;
+                        // SAFETY: a node pushes at most W - 1 entries (one child goes on as
+                        // `cur`), the single-ray traversal's bound (see `STACK`), which
+                        // `collapse` checked against the tree's depth.
+                        unsafe { stack.get_unchecked_mut(sp).write((node.children[c], passed[c], near[c])) };
+                        sp += 1;
+                    }
+                    let c = order[k - 1].0 as usize;
+                    (cur, active) = (node.children[c], passed[c]);
+                    continue;
+                }
+            }
+            // Pop, dropping the rays whose hits lie before the entry.
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                // SAFETY: entries `0..sp` were written above.
+                let (c, m, t_near) = unsafe { stack.get_unchecked(sp).assume_init() };
+                let m = m & packet.within(l, t_near);
+                if m != 0 {
+                    (cur, active) = (c, m);
                     break;
                 }
             }

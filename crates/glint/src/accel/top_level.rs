@@ -52,7 +52,14 @@ impl TopLevelBvh {
 
     /// A tree over the instances not in `flat`, plus one merged BVH over the triangles of the
     /// instances in `flat` (instance number, its mesh in world space).
+    ///
+    /// The merged triangles are numbered in ascending instance order (then the mesh's own
+    /// order), so the flat BVH's tie rule, smallest `(t, triangle)`, is the scene's
+    /// smallest `(t, instance, triangle)`.
     pub fn build_flattening(bounds: &[Aabb], split: BvhSplit, flat: &[FlatMesh]) -> TopLevelBvh {
+        let mut flat = flat.to_vec();
+        flat.sort_by_key(|f| f.instance);
+        let flat = &flat[..];
         let in_flat: std::collections::HashSet<u32> = flat.iter().map(|f| f.instance).collect();
         let rest: Vec<u32> = (0..bounds.len() as u32).filter(|i| !in_flat.contains(i)).collect();
         let rest_bounds: Vec<Aabb> = rest.iter().map(|&i| bounds[i as usize]).collect();
@@ -92,8 +99,8 @@ impl TopLevelBvh {
         top
     }
 
-    /// Closest hit among the flattened instances: (instance, triangle, hit); shortens
-    /// `ray.t_max`.
+    /// Closest hit among the flattened instances: (instance, triangle, hit), the smallest
+    /// `(t, instance, triangle)`; shortens `ray.t_max`.
     #[inline]
     pub fn intersect_flat(&self, ray: &mut Ray) -> Option<(u32, u32, TriangleHit)> {
         let (g, h) = self.flat.as_ref()?.intersect(ray, SimdPath::detect())?;
@@ -119,6 +126,27 @@ impl TopLevelBvh {
         };
         let mut global = vec![None; rays.len()];
         flat.intersect_batch(rays, &mut global, SimdPath::detect());
+        for (out, g) in hits.iter_mut().zip(global) {
+            *out = g.map(|(g, h)| {
+                let k = self.flat_offsets.partition_point(|&o| o <= g) - 1;
+                (self.flat_instances[k], g - self.flat_offsets[k], h)
+            });
+        }
+    }
+
+    /// [`TopLevelBvh::intersect_flat`] of many rays, in packets
+    /// (`TriangleWideBvh::intersect_packets`, bit-identical answers); `hits[i]` is for
+    /// `rays[i]`, which are not shortened.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_flat_packets(&self, rays: &[Ray], hits: &mut [Option<(u32, u32, TriangleHit)>]) {
+        assert_eq!(rays.len(), hits.len(), "intersect_flat_packets: one hit slot per ray");
+        let Some(flat) = &self.flat else {
+            hits.fill(None);
+            return;
+        };
+        let mut global = vec![None; rays.len()];
+        flat.intersect_packets(rays, &mut global, SimdPath::detect());
         for (out, g) in hits.iter_mut().zip(global) {
             *out = g.map(|(g, h)| {
                 let k = self.flat_offsets.partition_point(|&o| o <= g) - 1;

@@ -1,8 +1,9 @@
 //! Triangles in blocks of four, structure-of-arrays, in leaf order: what the wide BVH's
 //! leaves point to. A block holds its own copy of the vertices (no index indirection on the
 //! hot path) and the original triangle numbers. Unused lanes repeat the block's first
-//! triangle (same vertices, same number), so they change no answer (the first of equal
-//! lanes wins) and let a block that the ray misses be rejected early.
+//! triangle (same vertices, same number), so they change no answer (a lane equal in both t
+//! and triangle number to another is the same hit) and let a block that the ray misses be
+//! rejected early.
 
 use super::triangle::ShearedRay;
 use crate::math::{Ray, Vec3};
@@ -72,20 +73,26 @@ pub type Tri4Hits = TriHits<4>;
 impl<const N: usize> TriHits<N> {
     pub const NONE: TriHits<N> = TriHits { mask: 0, t: [0.0; N], b1: [0.0; N], b2: [0.0; N] };
 
-    /// The nearest lane hit, the first among equals (as testing the lanes in order with a
-    /// shrinking interval would find).
+    /// The lane hit with the smallest `(t, prim(lane))`: the nearest, and of equal distances
+    /// the lowest triangle number (the tie rule of every closest-hit kernel, see
+    /// `accel::wide::ClosestLeaf`), whatever order the lanes are in.
     #[inline(always)]
-    pub fn nearest(&self) -> Option<usize> {
+    pub fn nearest(&self, prim: impl Fn(usize) -> u32) -> Option<usize> {
         let mut m = self.mask;
-        let mut best: Option<usize> = None;
+        if m == 0 {
+            return None;
+        }
+        let mut best = m.trailing_zeros() as usize;
+        m &= m - 1;
         while m != 0 {
             let i = m.trailing_zeros() as usize;
             m &= m - 1;
-            if best.is_none_or(|b| self.t[i] < self.t[b]) {
-                best = Some(i);
+            // Triangle numbers are looked up on exact ties only (rare).
+            if self.t[i] < self.t[best] || (self.t[i] == self.t[best] && prim(i) < prim(best)) {
+                best = i;
             }
         }
-        best
+        Some(best)
     }
 }
 

@@ -190,6 +190,16 @@ pub struct WideStats {
 /// `ray.t_max` on a hit and say whether there was one. A trait rather than a closure so that
 /// implementations can be `#[inline(always)]`: a call per leaf would spill the vector
 /// registers that hold the ray.
+///
+/// **The tie rule.** Every closest-hit kernel (single ray, batch, packet, the binary
+/// reference and brute force) answers with the hit of smallest `(t, primitive)`: the nearest,
+/// and among hits at exactly the same `t` (a ray through a shared edge or vertex, coincident
+/// triangles) the lowest primitive number, so that the answer does not depend on the order
+/// leaves are visited in. Implementations keep it by setting `ray.t_max` to the next float
+/// above the best `t` (so hits at an equal `t` are still reported by tests that accept
+/// `t < t_max`, and boxes entered at that `t` are not culled) and comparing `(t, primitive)`
+/// when they take a hit. Across a scene's instances the order is `(t, instance, primitive)`
+/// (`World::intersect`).
 pub trait ClosestLeaf {
     fn test(&mut self, first: u32, count: u32, ray: &mut Ray) -> bool;
 
@@ -353,11 +363,30 @@ impl<const W: usize> WideBvh<W> {
         if self.root == EMPTY_CHILD {
             return false;
         }
-        let nr = NodeRay::new(ray);
+        // SAFETY: the root of a non-empty tree; `S` is the caller's.
+        unsafe { self.traverse_from::<S>(self.root, ray, &NodeRay::new(ray), leaf) }
+    }
+
+    /// Closest-hit traversal of the subtree at `start` (the packet traversal's single-ray
+    /// fall-back starts below the root).
+    ///
+    /// # Safety
+    /// `S` must be available on this CPU; `start` must be the root of a non-empty tree or a
+    /// node reference from a slot whose box the ray passes; `nr` must be `NodeRay::new(ray)`
+    /// (of the ray's origin and direction, which traversal does not change).
+    #[inline(always)]
+    pub(super) unsafe fn traverse_from<S: Isa>(
+        &self,
+        start: u32,
+        ray: &mut Ray,
+        nr: &NodeRay,
+        leaf: &mut impl ClosestLeaf,
+    ) -> bool {
+        let nr = *nr;
         let nodes: &[WideNode<W>] = &self.nodes;
         let mut stack: [MaybeUninit<(u32, f32)>; STACK] = [const { MaybeUninit::uninit() }; STACK];
         let mut sp = 0usize;
-        let mut cur = self.root;
+        let mut cur = start;
         let mut found = false;
         loop {
             if cur & LEAF_BIT == 0 {

@@ -32,8 +32,13 @@ unsafe fn leaf_blocks(blocks: &[Tri4], first: u32, count: u32) -> &[Tri4] {
 
 /// Closest hit among leaves' blocks of four, tested two blocks at a time (one AVX2 test;
 /// four blocks in one 16-lane AVX-512 test were slower, see BENCHMARKS.md).
-/// Testing a pair and taking its nearest lane, the first among equals, is what testing the
-/// two blocks in turn with a shrinking interval gives, so the hit is the same bits.
+///
+/// The tie rule ([`ClosestLeaf`]): the hit kept is the smallest `(t, triangle)`. Once there
+/// is a best hit at `t`, the ray's `t_max` is the next float above `t`, so the kernels (which
+/// accept `t' < t_max`) report exactly the hits at `t' <= t`, and a hit at an equal `t`
+/// replaces the best only with a lower triangle number. Testing a pair and taking its
+/// smallest `(t, triangle)` lane is then what testing the two blocks in turn gives, and the
+/// answer does not depend on the order leaves are visited in.
 struct Closest<'a, S> {
     blocks: &'a [Tri4],
     tr: TriRay,
@@ -41,12 +46,46 @@ struct Closest<'a, S> {
     isa: PhantomData<S>,
 }
 
+/// The next float above `t`, [`f32::next_up`] with the common case (a positive finite `t`,
+/// whose next float is one bit pattern up, `f32::MAX`'s being +inf) first.
+#[inline(always)]
+pub(crate) fn float_above(t: f32) -> f32 {
+    if t > 0.0 && t < f32::INFINITY {
+        f32::from_bits(t.to_bits() + 1)
+    } else {
+        t.next_up()
+    }
+}
+
+// By hand: a derive would ask `S: Copy`.
+impl<S> Clone for Closest<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<S> Copy for Closest<'_, S> {}
+
 impl<'a, S: Isa> Closest<'a, S> {
     #[inline(always)]
+    fn new(blocks: &'a [Tri4], ray: &Ray) -> Closest<'a, S> {
+        Closest { blocks, tr: TriRay::new(ray), best: None, isa: PhantomData }
+    }
+
+    #[inline(always)]
     fn take<const N: usize>(&mut self, h: &TriHits<N>, prim: impl Fn(usize) -> u32, r: &mut Ray) -> bool {
-        let Some(lane) = h.nearest() else { return false };
-        r.t_max = h.t[lane];
-        self.best = Some((prim(lane), TriangleHit { t: h.t[lane], b1: h.b1[lane], b2: h.b2[lane] }));
+        let Some(lane) = h.nearest(&prim) else { return false };
+        let t = h.t[lane];
+        if let Some((bp, bh)) = &self.best {
+            // `t <= bh.t` by the kernels' bound; an equal `t` wins with a lower number only.
+            if !(t < bh.t || (t == bh.t && prim(lane) < *bp)) {
+                return false;
+            }
+        }
+        let p = prim(lane);
+        // The kernels accept only `t > t_min && t < t_max`, so `t` is finite and below
+        // `r.t_max`: its next float up is at most `r.t_max`, and the interval only shrinks.
+        r.t_max = float_above(t);
+        self.best = Some((p, TriangleHit { t, b1: h.b1[lane], b2: h.b2[lane] }));
         true
     }
 
@@ -61,7 +100,8 @@ impl<'a, S: Isa> Closest<'a, S> {
                 continue;
             };
             // SAFETY: `S` is available (the only callers are `intersect_generic`'s and
-            // `intersect_batch_generic`'s, which require it); the kernel reads only `a`, `b`
+            // `intersect_batch_generic`'s and `intersect_packets_generic`'s, which require
+            // it); the kernel reads only `a`, `b`
             // and `self.tr`.
             let h = unsafe { S::tri8(a, b, &self.tr, r.t_min, r.t_max) };
             hit |= self.take(&h, |lane| if lane < 4 { a.prim[lane] } else { b.prim[lane - 4] }, r);
@@ -265,6 +305,11 @@ impl<const W: usize> TriangleWideBvh<W> {
     unsafe fn intersect_generic<S: Isa>(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
         let mut leaf = Closest::<S> { blocks: &self.blocks, tr: TriRay::new(ray), best: None, isa: PhantomData };
         self.tree.traverse::<S>(ray, &mut leaf);
+        // Traversal left `t_max` just above the hit (see `Closest`): shortened to the hit, as
+        // callers expect.
+        if let Some((_, h)) = &leaf.best {
+            ray.t_max = h.t;
+        }
         leaf.best
     }
 
@@ -411,6 +456,85 @@ impl<const W: usize> TriangleWideBvh<W> {
             let bits = unsafe { self.tree.occluded_packet::<S, L, _>(l, r, &leaf, single_below) };
             for (i, b) in b.iter_mut().enumerate() {
                 *b = bits >> i & 1 == 1;
+            }
+        }
+    }
+
+    /// Closest hits of many rays in packets (see `packet.rs`): `hits[i]` is
+    /// [`TriangleWideBvh::intersect`] of `rays[i]`, bit for bit (the tie rule makes the
+    /// answer independent of the packet's visit order); sixteen rays per packet on the
+    /// AVX-512 path, eight on AVX2, one on the others. The rays are not shortened.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_packets(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>], path: SimdPath) {
+        self.intersect_packets_split(rays, hits, path, SINGLE_BELOW);
+    }
+
+    /// [`TriangleWideBvh::intersect_packets`] with rays leaving the packet where fewer than
+    /// `single_below` are active at a node (0: never), for tests and measurements; the
+    /// answers are the same for every value.
+    pub fn intersect_packets_split(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        path: SimdPath,
+        single_below: u32,
+    ) {
+        assert_eq!(rays.len(), hits.len(), "intersect_packets: one hit slot per ray");
+        let s = single_below;
+        // SAFETY (every arm): each path runs only where the CPU has it.
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 if path.is_available() => unsafe { self.intersect_packets_avx2(rays, hits, s) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 if path.is_available() => unsafe { self.intersect_packets_avx512(rays, hits, s) },
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Sse => unsafe { self.intersect_packets_generic::<Sse, One>(One, rays, hits, s) },
+            _ => unsafe { self.intersect_packets_generic::<Scalar, One>(One, rays, hits, s) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn intersect_packets_avx2(&self, rays: &[Ray], hits: &mut [Option<(u32, TriangleHit)>], single_below: u32) {
+        // SAFETY: this path runs only where AVX2 is available (`intersect_packets`).
+        let l = unsafe { Avx2x8::new_unchecked() };
+        self.intersect_packets_generic::<Avx2, Avx2x8>(l, rays, hits, single_below)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    unsafe fn intersect_packets_avx512(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        single_below: u32,
+    ) {
+        // SAFETY: the AVX-512 path requires AVX-512F (`SimdPath::is_available`).
+        let l = unsafe { Avx512x16::new_unchecked() };
+        self.intersect_packets_generic::<Avx512, Avx512x16>(l, rays, hits, single_below)
+    }
+
+    #[inline(always)]
+    unsafe fn intersect_packets_generic<S: Isa, L: Lanes>(
+        &self,
+        l: L,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        single_below: u32,
+    ) {
+        let blocks: &[Tri4] = &self.blocks;
+        for (r, h) in rays.chunks(L::N).zip(hits.chunks_mut(L::N)) {
+            let mut local = [r[0]; MAX_LANES];
+            local[..r.len()].copy_from_slice(r);
+            let mut leaves = [Closest::<S>::new(blocks, &r[0]); MAX_LANES];
+            for (leaf, ray) in leaves.iter_mut().zip(r).skip(1) {
+                *leaf = Closest::new(blocks, ray);
+            }
+            // SAFETY: `S` is available (this function's callers).
+            unsafe { self.tree.intersect_packet::<S, L, _>(l, &mut local[..r.len()], &mut leaves, single_below) };
+            for (h, leaf) in h.iter_mut().zip(&leaves) {
+                *h = leaf.best;
             }
         }
     }

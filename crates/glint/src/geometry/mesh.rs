@@ -256,21 +256,45 @@ impl TriangleMesh {
         }
     }
 
-    /// Closest hit through the binary BVH: the reference implementation.
+    /// Closest hits of many rays in packets (`TriangleWideBvh::intersect_packets`): `hits[i]`
+    /// is `intersect_with(rays[i], path)`, bit for bit; rays leave a packet where fewer than
+    /// `single_below` are active. Panics if the slices differ in length.
+    pub fn intersect_packets_with(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<(u32, TriangleHit)>],
+        path: SimdPath,
+        single_below: u32,
+    ) {
+        match &self.wide {
+            WideTris::W8(w) => w.intersect_packets_split(rays, hits, path, single_below),
+            WideTris::W4(w) => w.intersect_packets_split(rays, hits, path, single_below),
+            WideTris::None => self.intersect_batch_with(rays, hits, path),
+        }
+    }
+
+    /// Closest hit through the binary BVH: the reference implementation. Of hits at equal
+    /// `t`, the lowest triangle number (the tie rule, see `accel::wide::ClosestLeaf`).
     #[inline]
     pub fn intersect_reference(&self, ray: &mut Ray) -> Option<(u32, TriangleHit)> {
         let sh = ShearedRay::new(ray.dir);
-        let mut best = None;
+        let mut best: Option<(u32, TriangleHit)> = None;
         self.bvh.traverse(ray, |tri, r| {
             let [a, b, c] = self.vertices(tri as usize);
-            if let Some(h) = intersect_triangle(r, &sh, a, b, c) {
-                r.t_max = h.t;
-                best = Some((tri, h));
-                true
-            } else {
-                false
+            match intersect_triangle(r, &sh, a, b, c) {
+                // `r.t_max` is just above the best `t` (below), so `h.t <= best t` here.
+                Some(h) if best.is_none_or(|(bt, bh)| h.t < bh.t || (h.t == bh.t && tri < bt)) => {
+                    // `h.t < r.t_max` (the test's interval), so the interval only shrinks.
+                    r.t_max = h.t.next_up();
+                    best = Some((tri, h));
+                    true
+                }
+                _ => false,
             }
         });
+        if let Some((_, h)) = &best {
+            ray.t_max = h.t;
+        }
         best
     }
 
@@ -284,6 +308,8 @@ impl TriangleMesh {
     }
 
     /// Closest hit by testing every triangle: the reference that the BVH must agree with.
+    /// Triangles are tested in ascending order and a later one must be strictly nearer, so
+    /// the answer is the smallest `(t, triangle)` (the tie rule of every kernel).
     pub fn intersect_brute_force(&self, ray: &Ray) -> Option<(u32, TriangleHit)> {
         let sh = ShearedRay::new(ray.dir);
         let mut r = *ray;

@@ -46,13 +46,19 @@ pub fn li_batch(
     let mut blocked: Vec<bool> = Vec::with_capacity(live.len());
     let mut stepping: Vec<Stepping> = Vec::with_capacity(live.len());
     let mut order: Vec<u64> = Vec::with_capacity(live.len());
+    // Closest hits in packets for the camera rays only (the first wave): they are coherent;
+    // later waves' rays scatter, and go through the single-ray kernels (same bits either way).
+    let mut closest = traversal;
     while !live.is_empty() {
         // Camera rays that look through hidden emitters are traced one at a time (below).
         rays.clear();
         rays.extend(live.iter().map(|&i| &paths[i]).filter(|p| !p.traces_hidden_emitters(s)).map(|p| p.ray));
         hits.clear();
         hits.resize(rays.len(), None);
-        scene.intersect_many(&rays, &mut hits, traversal);
+        scene.intersect_many(&rays, &mut hits, closest);
+        if closest == BatchTraversal::Packets {
+            closest = BatchTraversal::OneByOne;
+        }
         c.rays += rays.len() as u64;
 
         // Paths step grouped by the instance they hit, so that consecutive steps run the same

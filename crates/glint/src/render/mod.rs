@@ -51,9 +51,10 @@ pub enum Schedule {
     /// As `Wavefront`, the batches traced by the interleaved batch traversal (several rays in
     /// flight per thread): 3 to 5% slower than `Wavefront` on Zen 5 (BENCHMARKS.md).
     WavefrontInterleaved,
-    /// As `Wavefront`, the shadow rays traced in packets (8 or 16 rays per instruction,
-    /// `accel::packet`): 1.07 to 1.36x the single rays' occlusion on the bunny and dragon ray
-    /// sets, 0.8 to 0.9x on the room, about even in renders (BENCHMARKS.md), so not the default.
+    /// As `Wavefront`, the shadow rays and the camera rays' closest hits traced in packets
+    /// (8 or 16 rays per instruction, `accel::packet`): 1.07 to 1.36x the single rays'
+    /// occlusion on the bunny and dragon ray sets, 0.8 to 0.9x on the room, about even in
+    /// renders (BENCHMARKS.md), so not the default.
     WavefrontPackets,
     /// As `WavefrontPackets`, the path tracer's Lambertian vertices shaded 8 or 16 paths per
     /// instruction (`integrators::vertex_lanes`; the other BSDFs one path at a time). The

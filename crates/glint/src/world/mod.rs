@@ -49,7 +49,8 @@ pub enum BatchTraversal {
     OneByOne,
     /// Several traversals in flight per thread, interleaved ([`World::intersect_batch`]).
     Interleaved,
-    /// Closest hits one by one, occlusion in packets of rays ([`World::occluded_packets`]).
+    /// Closest hits and occlusion in packets of rays ([`World::intersect_packets`],
+    /// [`World::occluded_packets`]).
     Packets,
 }
 
@@ -347,11 +348,29 @@ impl World {
         }
     }
 
+    /// Closest hits of many rays, the flat BVH traced in packets of rays: `hits[i]` is
+    /// [`World::intersect`] of `rays[i]`, bit for bit (the tie rule makes the answer
+    /// independent of visit order); the instances outside the flat BVH are then traced one
+    /// ray at a time.
+    ///
+    /// Panics if the slices differ in length.
+    pub fn intersect_packets(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "intersect_packets: one hit slot per ray");
+        let mut flat = vec![None; rays.len()];
+        self.top.intersect_flat_packets(rays, &mut flat);
+        for ((ray, f), out) in rays.iter().zip(flat).zip(hits.iter_mut()) {
+            let best = f.map(|(instance, prim, h)| Hit { t: h.t, instance, prim, b1: h.b1, b2: h.b2 });
+            let mut r = Ray { t_max: best.map_or(ray.t_max, |h| h.t), ..*ray };
+            *out = self.intersect_unflattened(&mut r, best);
+        }
+    }
+
     /// Closest hits of many rays traced as `traversal` says (same answers either way).
     pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>], traversal: BatchTraversal) {
         match traversal {
             BatchTraversal::Interleaved => self.intersect_batch(rays, hits),
-            BatchTraversal::OneByOne | BatchTraversal::Packets => {
+            BatchTraversal::Packets => self.intersect_packets(rays, hits),
+            BatchTraversal::OneByOne => {
                 assert_eq!(rays.len(), hits.len(), "intersect_many: one hit slot per ray");
                 for (r, h) in rays.iter().zip(hits.iter_mut()) {
                     *h = self.intersect(r);
@@ -398,7 +417,14 @@ impl World {
     }
 
     /// The closest hit among the instances outside the flat BVH, or `best` (the flat BVH's,
-    /// whose distance `r.t_max` already is) when none is nearer.
+    /// whose distance `r.t_max` already is) when none comes first.
+    ///
+    /// The order of hits (the tie rule, see `accel::wide::ClosestLeaf`): smallest
+    /// `(t, instance, prim)`, so that which instance or primitive a ray through a shared edge
+    /// or coincident surfaces reports does not depend on the order anything is visited in.
+    /// `r.t_max` stays the best `t` (it culls the top-level tree, whose box test keeps boxes
+    /// entered at exactly that `t`); each instance is asked with the next float up as its
+    /// bound (see `intersect_instance`) and answers with its own smallest `(t, prim)`.
     #[inline]
     fn intersect_unflattened(&self, r: &mut Ray, mut best: Option<Hit>) -> Option<Hit> {
         if !self.top.has_unflattened() {
@@ -406,19 +432,38 @@ impl World {
         }
         self.top.traverse(r, |inst_idx, r| {
             let inst = &self.instances[inst_idx as usize];
-            if let Some(h) = self.intersect_instance(inst, r) {
-                r.t_max = h.t;
-                best = Some(Hit { instance: inst_idx, ..h });
-                true
-            } else {
-                false
+            let found = self.intersect_instance(inst, r, best.is_some());
+            match found {
+                Some(h) if best.is_none_or(|b| hit_before(h.t, inst_idx, h.prim, &b)) => {
+                    r.t_max = h.t;
+                    best = Some(Hit { instance: inst_idx, ..h });
+                    true
+                }
+                _ => false,
             }
         });
         best
     }
 
+    /// One instance's closest hit within `r`'s interval, its own smallest `(t, prim)`; with
+    /// `tie` (a best hit at `r.t_max` exists), hits at exactly `r.t_max` count too.
+    ///
+    /// Signed distance grids and curves are asked with `r` as it is: their root searches use
+    /// the interval's end, so a bound one float higher could move their hits' bits. Their ties
+    /// with another instance at exactly the same `t` keep the instance found first (rare, and
+    /// so not yet order-independent); their own primitives follow the rule (curves compare
+    /// `(t, point)`; grids' voxels are in their own BVH's order, also not yet).
     #[inline]
-    fn intersect_instance(&self, inst: &Instance, r: &Ray) -> Option<Hit> {
+    fn intersect_instance(&self, inst: &Instance, r: &Ray, tie: bool) -> Option<Hit> {
+        let widened;
+        let r = match inst.shape {
+            ShapeRef::Mesh(_) | ShapeRef::Sphere(_) | ShapeRef::Cylinder(_) if tie => {
+                // `r.t_max` is a hit's `t`, finite, so the next float up is a valid bound.
+                widened = Ray { t_max: r.t_max.next_up(), ..*r };
+                &widened
+            }
+            _ => r,
+        };
         match inst.shape {
             ShapeRef::Mesh(m) => {
                 let mesh = &self.meshes[m as usize];
@@ -778,6 +823,13 @@ pub(crate) fn unit_normals(ng: Vec3, ns: Option<Vec3>, flip_normals: bool) -> (V
         n_shading = ng;
     }
     (ng, n_shading)
+}
+
+/// Whether a hit at `t` on `(instance, prim)` comes before `best` in the order of closest
+/// hits: smallest `(t, instance, prim)`.
+#[inline(always)]
+fn hit_before(t: f32, instance: u32, prim: u32, best: &Hit) -> bool {
+    t < best.t || (t == best.t && (instance, prim) < (best.instance, best.prim))
 }
 
 /// The traversal hit of a curve: `prim` its segment's first control point, `b1` the
