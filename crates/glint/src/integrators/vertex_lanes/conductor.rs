@@ -16,7 +16,7 @@ use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
 
 /// Up to [`MAX_LANES`] smooth-conductor vertices, one per lane.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Default)]
 pub(crate) struct MirrorChunk {
     pub len: usize,
     pub path: [u32; MAX_LANES],
@@ -35,30 +35,6 @@ pub(crate) struct MirrorChunk {
     pub(super) weight: Column3,
     pub(super) next_origin: Column3,
     pub(super) next_dir: Column3,
-}
-
-impl Default for MirrorChunk {
-    fn default() -> Self {
-        let c = [0.0; MAX_LANES];
-        let c3 = [c; 3];
-        MirrorChunk {
-            len: 0,
-            path: [0; MAX_LANES],
-            dir: c3,
-            p: c3,
-            ng: c3,
-            n: c3,
-            s: c3,
-            t: c3,
-            eta: c3,
-            k: c3,
-            specular: c3,
-            sampled: c,
-            weight: c3,
-            next_origin: c3,
-            next_dir: c3,
-        }
-    }
 }
 
 impl MirrorChunk {

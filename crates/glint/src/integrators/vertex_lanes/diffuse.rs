@@ -19,7 +19,7 @@ use crate::world::SurfaceInteraction;
 
 /// Up to [`MAX_LANES`] diffuse vertices, one per lane: what the scalar code gathered, and what
 /// the kernel leaves. Flags are 1.0 (true) or 0.0.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Default)]
 pub(crate) struct DiffuseChunk {
     pub len: usize,
     /// Which path each lane is (the caller's index).
@@ -66,51 +66,6 @@ pub(crate) struct DiffuseChunk {
     pub(super) next_origin: Column3,
     pub(super) next_dir: Column3,
     pub(super) pdf: Column,
-}
-
-impl Default for DiffuseChunk {
-    fn default() -> Self {
-        let c = [0.0; MAX_LANES];
-        let c3 = [c; 3];
-        DiffuseChunk {
-            len: 0,
-            path: [0; MAX_LANES],
-            dir: c3,
-            p: c3,
-            ng: c3,
-            n: c3,
-            s: c3,
-            t: c3,
-            reflectance: c3,
-            throughput: c3,
-            has_light: c,
-            light_wi: c3,
-            light_dist: c,
-            light_radiance: c3,
-            light_pdf: c,
-            light_delta: c,
-            u: [c; 2],
-            from_mesh: c,
-            corners: [c3; 3],
-            bary: c3,
-            has_normals: c,
-            normals: [c3; 3],
-            has_uvs: c,
-            uvs: [[c; 2]; 3],
-            flip_normals: c,
-            two_sided: c,
-            shadow: c,
-            shadow_origin: c3,
-            shadow_dir: c3,
-            shadow_t_max: c,
-            contribution: c3,
-            mis_weight: c,
-            sampled: c,
-            next_origin: c3,
-            next_dir: c3,
-            pdf: c,
-        }
-    }
 }
 
 impl DiffuseChunk {

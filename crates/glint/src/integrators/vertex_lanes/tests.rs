@@ -18,9 +18,12 @@ use crate::world::{unit_normals, TriangleSurface};
 
 /// What the one-path code leaves: the shadow ray and its contribution and weight, and the
 /// next ray and its density.
+/// A shadow ray's origin, direction, end, contribution and MIS weight, as bits.
+type ShadowBits = ([u32; 3], [u32; 3], u32, [u32; 3], u32);
+
 #[derive(Debug, PartialEq)]
 struct Outcome {
-    shadow: Option<([u32; 3], [u32; 3], u32, [u32; 3], u32)>,
+    shadow: Option<ShadowBits>,
     next: Option<([u32; 3], [u32; 3], u32)>,
 }
 
@@ -51,8 +54,9 @@ struct Vertex {
     u: [f32; 2],
 }
 
-fn reference(v: &Vertex, light_only: bool) -> Outcome {
-    let si = SurfaceInteraction {
+/// The interaction the one-path code would have at the vertex (what the kernels read of it).
+fn surface(v: &Vertex) -> SurfaceInteraction {
+    SurfaceInteraction {
         p: v.p,
         ng: v.ng,
         frame: v.frame,
@@ -65,7 +69,11 @@ fn reference(v: &Vertex, light_only: bool) -> Outcome {
         dpdv: Vec3::ZERO,
         prim: 0,
         bary: [0.0; 2],
-    };
+    }
+}
+
+fn reference(v: &Vertex, light_only: bool) -> Outcome {
+    let si = surface(v);
     let bsdf = Bsdf::Diffuse(Diffuse { reflectance: v.reflectance });
     let wo = v.frame.to_local(-v.dir);
     let mut shadow = None;
@@ -127,7 +135,7 @@ const SPECIAL: [f32; 10] = [0.0, -0.0, 1.0, -1.0, f32::INFINITY, f32::NEG_INFINI
 
 /// A value that is special one time in `1 / rate`, else uniform in [-range, range].
 fn value(rng: &mut Rng, range: f32, rate: u32) -> f32 {
-    if rng.next_u32() % rate == 0 {
+    if rng.next_u32().is_multiple_of(rate) {
         SPECIAL[(rng.next_u32() % SPECIAL.len() as u32) as usize]
     } else {
         (2.0 * rng.next_f32() - 1.0) * range
@@ -154,20 +162,20 @@ fn vertex(rng: &mut Rng) -> Vertex {
     let n = unit(rng, 40);
     let frame = Frame::from_normal(n);
     // Directions near the tangent plane now and then (grazing).
-    let dir = if rng.next_u32() % 8 == 0 { frame.s * -1.0 + n * value(rng, 1e-6, 40) } else { unit(rng, 40) };
-    let light = (rng.next_u32() % 5 != 0).then(|| LightSample {
-        wi: if rng.next_u32() % 8 == 0 { frame.t + n * value(rng, 1e-6, 40) } else { unit(rng, 40) },
+    let dir = if rng.next_u32().is_multiple_of(8) { frame.s * -1.0 + n * value(rng, 1e-6, 40) } else { unit(rng, 40) };
+    let light = (!rng.next_u32().is_multiple_of(5)).then(|| LightSample {
+        wi: if rng.next_u32().is_multiple_of(8) { frame.t + n * value(rng, 1e-6, 40) } else { unit(rng, 40) },
         radiance: Rgb::from_array([value(rng, 10.0, 40).abs(), value(rng, 10.0, 40).abs(), value(rng, 10.0, 40).abs()]),
         pdf: value(rng, 100.0, 40).abs(),
-        dist: if rng.next_u32() % 6 == 0 { f32::INFINITY } else { value(rng, 50.0, 40).abs() },
-        delta: rng.next_u32() % 7 == 0,
+        dist: if rng.next_u32().is_multiple_of(6) { f32::INFINITY } else { value(rng, 50.0, 40).abs() },
+        delta: rng.next_u32().is_multiple_of(7),
     });
-    let black = rng.next_u32() % 10 == 0;
+    let black = rng.next_u32().is_multiple_of(10);
     let refl = |rng: &mut Rng| if black { 0.0 } else { rng.next_f32() };
     Vertex {
         dir,
         p: vector(rng, 100.0, 40),
-        ng: if rng.next_u32() % 2 == 0 { n } else { unit(rng, 40) },
+        ng: if rng.next_u32().is_multiple_of(2) { n } else { unit(rng, 40) },
         frame,
         reflectance: Rgb::from_array([refl(rng), refl(rng), refl(rng)]),
         throughput: Rgb::from_array([value(rng, 4.0, 40).abs(), value(rng, 4.0, 40).abs(), rng.next_f32()]),
@@ -235,20 +243,20 @@ fn every_lane_scatters_as_the_one_path_code_does() {
 /// values now and then), normals (zero ones too) and uvs (repeated ones, a zero determinant).
 fn mesh_hit(rng: &mut Rng) -> (MeshHit, Vec3, Vec3) {
     let a = vector(rng, 10.0, 60);
-    let b = if rng.next_u32() % 12 == 0 { a } else { vector(rng, 10.0, 60) };
+    let b = if rng.next_u32().is_multiple_of(12) { a } else { vector(rng, 10.0, 60) };
     let c = vector(rng, 10.0, 60);
     let b1 = rng.next_f32();
     let b2 = rng.next_f32() * (1.0 - b1);
-    let normals = (rng.next_u32() % 3 != 0).then(|| {
-        if rng.next_u32() % 10 == 0 {
+    let normals = (!rng.next_u32().is_multiple_of(3)).then(|| {
+        if rng.next_u32().is_multiple_of(10) {
             [Vec3::ZERO; 3]
         } else {
             [unit(rng, 60), unit(rng, 60), unit(rng, 60)]
         }
     });
-    let uvs = (rng.next_u32() % 3 != 0).then(|| {
+    let uvs = (!rng.next_u32().is_multiple_of(3)).then(|| {
         let t0 = [value(rng, 1.0, 60), value(rng, 1.0, 60)];
-        let t1 = if rng.next_u32() % 10 == 0 { t0 } else { [value(rng, 1.0, 60), value(rng, 1.0, 60)] };
+        let t1 = if rng.next_u32().is_multiple_of(10) { t0 } else { [value(rng, 1.0, 60), value(rng, 1.0, 60)] };
         [t0, t1, [value(rng, 1.0, 60), value(rng, 1.0, 60)]]
     });
     let hit = MeshHit {
@@ -257,8 +265,8 @@ fn mesh_hit(rng: &mut Rng) -> (MeshHit, Vec3, Vec3) {
         normals,
         uvs,
         reflectance: Rgb::from_array([rng.next_f32(), rng.next_f32(), rng.next_f32()]),
-        flip_normals: rng.next_u32() % 4 == 0,
-        two_sided: rng.next_u32() % 2 == 0,
+        flip_normals: rng.next_u32().is_multiple_of(4),
+        two_sided: rng.next_u32().is_multiple_of(2),
     };
     let p = TriangleSurface::at(hit.corners, hit.normals, hit.uvs, b1, b2).p;
     (hit, p, unit(rng, 40))
@@ -339,20 +347,7 @@ fn check_mirrors(isa: LaneIsa) {
                 k: Rgb::from_array([value(&mut rng, 5.0, 30).abs(), 0.0, value(&mut rng, 5.0, 30)]),
                 specular: if round % 9 == 0 { Rgb::BLACK } else { Rgb::from_array([1.0, rng.next_f32(), 0.5]) },
             };
-            let si = SurfaceInteraction {
-                p: v.p,
-                ng: v.ng,
-                frame: v.frame,
-                uv: [0.0; 2],
-                instance: 0,
-                material: 0,
-                light: None,
-                t: 1.0,
-                dpdu: Vec3::ZERO,
-                dpdv: Vec3::ZERO,
-                prim: 0,
-                bary: [0.0; 2],
-            };
+            let si = surface(&v);
             let mut sampler = Sampler::from_rng(Rng::new(2, i as u64));
             let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
             chunk.push(i as u32, &path, &si, &v.frame, &mirror, &mut sampler);
