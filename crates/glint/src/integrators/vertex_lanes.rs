@@ -21,9 +21,9 @@
 //! BSDF of the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`. Every
 //! other BSDF steps through `PathState::scatter`, one path at a time.
 
-mod conductor;
 mod diffuse;
 mod lane_math;
+mod smooth;
 
 use super::estimators::sample_light;
 use super::observe::Unobserved;
@@ -40,8 +40,8 @@ use crate::math::lanes::{Lanes, One, MAX_LANES};
 use crate::math::{vec3, Rgb, Vec3};
 use crate::sampling::Sampler;
 use crate::world::{Hit, ShapeRef, World};
-use conductor::MirrorChunk;
 use diffuse::DiffuseChunk;
+use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -154,12 +154,12 @@ pub(crate) struct LaneStepper {
     lanes: usize,
     /// One chunk per BSDF class: a chunk's lanes run one kernel.
     chunk: DiffuseChunk,
-    mirrors: MirrorChunk,
+    smooth: SmoothChunk,
 }
 
 impl LaneStepper {
     pub fn new(isa: LaneIsa) -> LaneStepper {
-        LaneStepper { isa, lanes: isa.lanes(), chunk: DiffuseChunk::default(), mirrors: MirrorChunk::default() }
+        LaneStepper { isa, lanes: isa.lanes(), chunk: DiffuseChunk::default(), smooth: SmoothChunk::default() }
     }
 
     /// Path `i`'s step at `hit`; its results may wait until the chunk runs (at the latest at
@@ -192,11 +192,16 @@ impl LaneStepper {
         }
         let Some(si) = path.arrive(s, scene, hit, rng, &mut Unobserved) else { return };
         let (bsdf, frame) = shading(scene, &si, -path.ray.dir);
-        if let (Bsdf::Conductor(mirror), None) = (&bsdf.bsdf, &bsdf.tilt) {
+        let smooth = match (&bsdf.bsdf, &bsdf.tilt) {
+            (Bsdf::Conductor(m), None) => Some(Smooth::Conductor(*m)),
+            (Bsdf::Dielectric(d), None) => Some(Smooth::Dielectric(*d)),
+            _ => None,
+        };
+        if let Some(smooth) = smooth {
             // A delta BSDF: no light sample (`scatter` draws none either).
-            self.mirrors.push(i as u32, path, &si, &frame, mirror, rng);
-            if self.mirrors.is_full(self.lanes) {
-                self.flush_mirrors(s, paths, samples);
+            self.smooth.push(i as u32, path, &si, &frame, smooth, rng);
+            if self.smooth.is_full(self.lanes) {
+                self.flush_smooth(s, paths, samples);
             }
             return;
         }
@@ -224,19 +229,19 @@ impl LaneStepper {
     /// Runs the waiting vertices of every class and finishes their steps.
     pub fn flush(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample], c: &mut Counters) {
         self.flush_diffuse(s, paths, samples, c);
-        self.flush_mirrors(s, paths, samples);
+        self.flush_smooth(s, paths, samples);
     }
 
-    fn flush_mirrors(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample]) {
-        if self.mirrors.len == 0 {
+    fn flush_smooth(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample]) {
+        if self.smooth.len == 0 {
             return;
         }
-        self.mirrors.run(self.isa);
-        for lane in 0..self.mirrors.len {
-            let i = self.mirrors.path[lane] as usize;
-            self.mirrors.finish(lane, &mut paths[i], s, &mut samples[i].sampler);
+        self.smooth.run(self.isa);
+        for lane in 0..self.smooth.len {
+            let i = self.smooth.path[lane] as usize;
+            self.smooth.finish(lane, &mut paths[i], s, &mut samples[i].sampler);
         }
-        self.mirrors.len = 0;
+        self.smooth.len = 0;
     }
 
     fn flush_diffuse(

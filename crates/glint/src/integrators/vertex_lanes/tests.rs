@@ -6,11 +6,11 @@
 //! payload: Rust leaves those unspecified (LLVM may swap the operands of a multiplication),
 //! and the film discards a sample that is not finite.
 
-use super::conductor::MirrorChunk;
 use super::diffuse::DiffuseChunk;
+use super::smooth::{Smooth, SmoothChunk};
 use super::*;
 use crate::integrators::{shadow_ray, spawn_ray};
-use crate::materials::{Bsdf, Conductor, Diffuse};
+use crate::materials::{Bsdf, Conductor, Dielectric, Diffuse};
 use crate::math::{Frame, Ray};
 use crate::sampling::{power_heuristic, Rng};
 use crate::world::SurfaceInteraction;
@@ -329,58 +329,120 @@ fn every_lane_finds_the_mesh_frame_the_one_path_code_finds() {
     }
 }
 
-/// The smooth conductor's lane against `Conductor::sample`, `Frame::to_world` and
-/// `spawn_ray`: the next ray and the weight, or no sample.
-fn check_mirrors(isa: LaneIsa) {
+/// The smooth BSDFs' lanes against `Conductor::sample` and `Dielectric::sample` (with the
+/// lobe number the chunk drew), `Frame::to_world` and `spawn_ray`: the next ray, the weight
+/// and eta, or no sample. Conductors and dielectrics share chunks.
+fn check_smooth(isa: LaneIsa) {
     let lanes = isa.lanes();
     let mut rng = Rng::new(31, lanes as u64);
-    let mut kept = 0;
-    let mut total = 0;
+    let (mut kept, mut refracted, mut total) = (0, 0, 0);
     for round in 0..4000 {
-        let mut chunk = MirrorChunk::default();
+        let mut chunk = SmoothChunk::default();
         let mut want = Vec::new();
         for i in 0..lanes {
             let v = vertex(&mut rng);
-            // Gold-like to dielectric-like constants, and special values now and then.
-            let mirror = Conductor {
-                eta: Rgb::from_array([value(&mut rng, 3.0, 30).abs(), value(&mut rng, 3.0, 30), 1.5]),
-                k: Rgb::from_array([value(&mut rng, 5.0, 30).abs(), 0.0, value(&mut rng, 5.0, 30)]),
-                specular: if round % 9 == 0 { Rgb::BLACK } else { Rgb::from_array([1.0, rng.next_f32(), 0.5]) },
+            // Gold-like to dielectric-like constants, index-matched glass, special values.
+            let bsdf = if rng.next_u32().is_multiple_of(2) {
+                Smooth::Conductor(Conductor {
+                    eta: Rgb::from_array([value(&mut rng, 3.0, 30).abs(), value(&mut rng, 3.0, 30), 1.5]),
+                    k: Rgb::from_array([value(&mut rng, 5.0, 30).abs(), 0.0, value(&mut rng, 5.0, 30)]),
+                    specular: if round % 9 == 0 { Rgb::BLACK } else { Rgb::from_array([1.0, rng.next_f32(), 0.5]) },
+                })
+            } else {
+                let eta = match rng.next_u32() % 4 {
+                    0 => 1.0,
+                    1 => 1.0 / 1.5,
+                    _ => 1.0 + value(&mut rng, 1.5, 30).abs(),
+                };
+                Smooth::Dielectric(Dielectric {
+                    eta,
+                    reflect: Rgb::from_array([1.0, rng.next_f32(), 0.0]),
+                    transmit: if round % 11 == 0 { Rgb::BLACK } else { Rgb::from_array([rng.next_f32(), 1.0, 0.7]) },
+                })
             };
             let si = surface(&v);
-            let mut sampler = Sampler::from_rng(Rng::new(2, i as u64));
+            let mut sampler = Sampler::from_rng(Rng::new(2, (round * lanes + i) as u64));
             let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
-            chunk.push(i as u32, &path, &si, &v.frame, &mirror, &mut sampler);
+            chunk.push(i as u32, &path, &si, &v.frame, bsdf, &mut sampler);
             let wo = v.frame.to_local(-v.dir);
-            let sample = Bsdf::Conductor(mirror).sample(wo, 0.5, [0.5, 0.5]).filter(|bs| !bs.weight.is_black());
+            let scalar = match bsdf {
+                Smooth::Conductor(m) => Bsdf::Conductor(m),
+                Smooth::Dielectric(d) => Bsdf::Dielectric(d),
+            };
+            let sample = scalar.sample(wo, chunk.u_lobe[i], [0.5, 0.5]).filter(|bs| !bs.weight.is_black());
             want.push(sample.map(|bs| {
                 let r = spawn_ray(&si, v.frame.to_world(bs.wi));
-                (bits(r.origin), bits(r.dir), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)))
+                (bits(r.origin), bits(r.dir), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)), bits1(bs.eta))
             }));
         }
         chunk.run(isa);
         for (i, w) in want.iter().enumerate() {
             let got = (chunk.sampled[i] != 0.0).then(|| {
-                (bits(get3(&chunk.next_origin, i)), bits(get3(&chunk.next_dir, i)), bits(get3(&chunk.weight, i)))
+                (
+                    bits(get3(&chunk.next_origin, i)),
+                    bits(get3(&chunk.next_dir, i)),
+                    bits(get3(&chunk.weight, i)),
+                    bits1(chunk.eta_out[i]),
+                )
             });
             assert_eq!(&got, w, "{isa:?} lane {i}, round {round}");
             total += 1;
             kept += w.is_some() as u32;
+            refracted += w.is_some_and(|w| w.3 != 1.0f32.to_bits()) as u32;
         }
     }
-    assert!(kept > total / 4 && kept < total, "{isa:?}: {kept} samples kept of {total}");
+    assert!(
+        kept > total / 4 && kept < total && refracted > total / 10,
+        "{isa:?}: {kept} kept, {refracted} refracted of {total}"
+    );
 }
 
 #[test]
-fn every_lane_mirrors_as_the_one_path_code_does() {
-    check_mirrors(LaneIsa::One);
+fn every_lane_samples_smooth_bsdfs_as_the_one_path_code_does() {
+    check_smooth(LaneIsa::One);
     #[cfg(target_arch = "x86_64")]
     {
         if Avx2x8::new().is_some() {
-            check_mirrors(LaneIsa::Avx2);
+            check_smooth(LaneIsa::Avx2);
         }
         if Avx512x16::new().is_some() {
-            check_mirrors(LaneIsa::Avx512);
+            check_smooth(LaneIsa::Avx512);
+        }
+    }
+}
+
+/// The lanes' dielectric Fresnel term against `bsdf::fresnel_dielectric` (whose reflectance
+/// the sample tests above see only through the lobe choice).
+fn check_fresnel_dielectric<L: Lanes>(l: L) {
+    let mut rng = Rng::new(37, L::N as u64);
+    let mut out = [[0.0f32; MAX_LANES]; 3];
+    for _ in 0..20_000 {
+        let cos_i: Vec<f32> = (0..L::N).map(|_| value(&mut rng, 1.0, 20)).collect();
+        let eta: Vec<f32> = (0..L::N)
+            .map(|_| if rng.next_u32().is_multiple_of(8) { 1.0 } else { value(&mut rng, 2.5, 20).abs() })
+            .collect();
+        let fr = super::smooth::fresnel_dielectric(l, l.load(&cos_i), l.load(&eta));
+        l.store(fr.reflectance, &mut out[0]);
+        l.store(fr.cos_t, &mut out[1]);
+        l.store(fr.eta_ti, &mut out[2]);
+        for i in 0..L::N {
+            let want = crate::bsdf::fresnel_dielectric(cos_i[i], eta[i]);
+            let got = [out[0][i], out[1][i], out[2][i]].map(bits1);
+            assert_eq!(got, [want.reflectance, want.cos_t, want.eta_ti].map(bits1), "cos {} eta {}", cos_i[i], eta[i]);
+        }
+    }
+}
+
+#[test]
+fn every_lane_finds_the_dielectric_fresnel_term_of_the_one_path_code() {
+    check_fresnel_dielectric(One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if let Some(l) = Avx2x8::new() {
+            check_fresnel_dielectric(l);
+        }
+        if let Some(l) = Avx512x16::new() {
+            check_fresnel_dielectric(l);
         }
     }
 }

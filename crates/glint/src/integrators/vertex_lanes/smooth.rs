@@ -1,0 +1,250 @@
+//! The vertex of the smooth (delta) BSDFs in lanes, as `PathState::scatter` computes it for
+//! `Bsdf::Conductor` (the mirror direction, the conductor Fresnel term per channel) and
+//! `Bsdf::Dielectric` (the dielectric Fresnel term, reflection or refraction chosen by the
+//! lobe number): no light sample, no shadow ray, the next ray.
+
+use super::lane_math::*;
+use super::{get3, put3, Column, Column3, LaneIsa};
+use crate::describe::PathSettings;
+use crate::integrators::estimators::PrevEvent;
+use crate::integrators::path::PathState;
+use crate::materials::{Conductor, Dielectric};
+#[cfg(target_arch = "x86_64")]
+use crate::math::lanes::{Avx2x8, Avx512x16};
+use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::{Frame, Ray, Rgb};
+use crate::sampling::Sampler;
+use crate::world::SurfaceInteraction;
+
+/// A smooth BSDF the chunk takes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Smooth {
+    Conductor(Conductor),
+    Dielectric(Dielectric),
+}
+
+/// Up to [`MAX_LANES`] vertices of smooth BSDFs, one per lane.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct SmoothChunk {
+    pub len: usize,
+    pub path: [u32; MAX_LANES],
+    // In: the vertex and the conductor.
+    pub(super) dir: Column3,
+    pub(super) p: Column3,
+    pub(super) ng: Column3,
+    pub(super) n: Column3,
+    pub(super) s: Column3,
+    pub(super) t: Column3,
+    /// 1 for a dielectric, 0 for a conductor.
+    pub(super) glass: Column,
+    /// The conductor's eta, k and specular reflectance; the dielectric's eta (in the first
+    /// channel of `eta`), reflectance (`specular`) and transmittance.
+    pub(super) eta: Column3,
+    pub(super) k: Column3,
+    pub(super) specular: Column3,
+    pub(super) transmit: Column3,
+    pub(super) u_lobe: Column,
+    // Out: the next ray, the sample's weight and eta (`sampled` 0 where the path ends).
+    pub(super) sampled: Column,
+    pub(super) weight: Column3,
+    pub(super) eta_out: Column,
+    pub(super) next_origin: Column3,
+    pub(super) next_dir: Column3,
+}
+
+impl SmoothChunk {
+    pub fn is_full(&self, lanes: usize) -> bool {
+        self.len >= lanes
+    }
+
+    /// Adds a path's vertex as the next lane, drawing the BSDF's random numbers from `rng` as
+    /// `PathState::scatter` does (a lobe number, which the dielectric reads, and a square).
+    pub fn push(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        si: &SurfaceInteraction,
+        frame: &Frame,
+        bsdf: Smooth,
+        rng: &mut Sampler,
+    ) {
+        let i = self.len;
+        self.len += 1;
+        self.path[i] = path_index;
+        let d = path.ray.dir;
+        put3(&mut self.dir, i, [d.x, d.y, d.z]);
+        put3(&mut self.p, i, [si.p.x, si.p.y, si.p.z]);
+        put3(&mut self.ng, i, [si.ng.x, si.ng.y, si.ng.z]);
+        put3(&mut self.n, i, [frame.n.x, frame.n.y, frame.n.z]);
+        put3(&mut self.s, i, [frame.s.x, frame.s.y, frame.s.z]);
+        put3(&mut self.t, i, [frame.t.x, frame.t.y, frame.t.z]);
+        match bsdf {
+            Smooth::Conductor(m) => {
+                self.glass[i] = 0.0;
+                put3(&mut self.eta, i, m.eta.to_array());
+                put3(&mut self.k, i, m.k.to_array());
+                put3(&mut self.specular, i, m.specular.to_array());
+                put3(&mut self.transmit, i, [0.0; 3]);
+            }
+            Smooth::Dielectric(d) => {
+                self.glass[i] = 1.0;
+                put3(&mut self.eta, i, [d.eta, 1.0, 1.0]);
+                put3(&mut self.k, i, [0.0; 3]);
+                put3(&mut self.specular, i, d.reflect.to_array());
+                put3(&mut self.transmit, i, d.transmit.to_array());
+            }
+        }
+        self.u_lobe[i] = rng.next_f32();
+        let _u = rng.next_2d();
+    }
+
+    /// Runs the kernel over the chunk's lanes on `isa`.
+    pub fn run(&mut self, isa: LaneIsa) {
+        match isa {
+            LaneIsa::One => smooth_chunk(One, self),
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
+            LaneIsa::Avx2 => unsafe { smooth_chunk_avx2(self) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
+            LaneIsa::Avx512 => unsafe { smooth_chunk_avx512(self) },
+        }
+    }
+
+    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler) {
+        if self.sampled[i] == 0.0 {
+            return;
+        }
+        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
+        let prev = PrevEvent { pdf: 1.0, delta: true, p: get3(&self.p, i) };
+        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
+        path.go_on(s, weight, self.eta_out[i], prev, ray, rng);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn smooth_chunk_avx2(chunk: &mut SmoothChunk) {
+    // SAFETY: this function's contract is that the CPU has AVX2.
+    smooth_chunk(unsafe { Avx2x8::new_unchecked() }, chunk)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+unsafe fn smooth_chunk_avx512(chunk: &mut SmoothChunk) {
+    // SAFETY: this function's contract is that the CPU has AVX-512F.
+    smooth_chunk(unsafe { Avx512x16::new_unchecked() }, chunk)
+}
+
+#[inline(always)]
+fn smooth_chunk<L: Lanes>(l: L, c: &mut SmoothChunk) {
+    let mut base = 0;
+    while base < c.len {
+        smooth_lanes(l, c, base);
+        base += L::N;
+    }
+}
+
+/// One vector of the chunk's lanes, from `base`: `Conductor::sample` or `Dielectric::sample`
+/// (each computed only where a lane has it), then `frame.to_world` and `spawn_ray`.
+#[inline(always)]
+fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize) {
+    let (zero, one) = (l.splat(0.0), l.splat(1.0));
+    let wo_world = neg3(l, load3(l, &c.dir, base));
+    let (s, t, n) = (load3(l, &c.s, base), load3(l, &c.t, base), load3(l, &c.n, base));
+    // `frame.to_local(wo)`.
+    let wo = V3 { x: dot(l, wo_world, s), y: dot(l, wo_world, t), z: dot(l, wo_world, n) };
+    let (eta, spec) = (load3(l, &c.eta, base), load3(l, &c.specular, base));
+    let glass = l.gt(l.load(&c.glass[base..]), zero);
+    let mirror = l.not(glass);
+    let reflected = V3 { x: l.neg(wo.x), y: l.neg(wo.y), z: wo.z };
+    // The conductor: the mirror direction, where `wo` is above the surface.
+    let (mut wi, mut weight, mut sampled, mut eta_out) = (reflected, spec, l.not(l.le(wo.z, zero)), one);
+    if l.bits(mirror) != 0 {
+        let k = load3(l, &c.k, base);
+        weight = V3 {
+            x: l.mul(spec.x, fresnel_conductor(l, wo.z, eta.x, k.x)),
+            y: l.mul(spec.y, fresnel_conductor(l, wo.z, eta.y, k.y)),
+            z: l.mul(spec.z, fresnel_conductor(l, wo.z, eta.z, k.z)),
+        };
+    }
+    if l.bits(glass) != 0 {
+        let fr = fresnel_dielectric(l, wo.z, eta.x);
+        let reflect = l.lt(l.load(&c.u_lobe[base..]), fr.reflectance);
+        // `refract_local(wo, fr)`, and the radiance scale 1 / eta_ti².
+        let k = l.div(l.splat(-1.0), fr.eta_ti);
+        let refracted = V3 { x: l.mul(wo.x, k), y: l.mul(wo.y, k), z: fr.cos_t };
+        let transmit = load3(l, &c.transmit, base);
+        let scaled = scale(l, transmit, l.div(one, l.mul(fr.eta_ti, fr.eta_ti)));
+        wi = select3(l, glass, select3(l, reflect, reflected, refracted), wi);
+        weight = select3(l, glass, select3(l, reflect, spec, scaled), weight);
+        eta_out = l.select(glass, l.select(reflect, one, fr.eta_ti), eta_out);
+        // `Dielectric::sample` always samples.
+        sampled = l.or(glass, l.and(mirror, sampled));
+    }
+    let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
+    let sampled = l.and_not(sampled, black);
+    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
+    store3(l, weight, &mut c.weight, base);
+    l.store(eta_out, &mut c.eta_out[base..]);
+    let wi_world = add3(l, add3(l, scale(l, s, wi.x), scale(l, t, wi.y)), scale(l, n, wi.z));
+    store3(l, wi_world, &mut c.next_dir, base);
+    let (p, ng) = (load3(l, &c.p, base), load3(l, &c.ng, base));
+    store3(l, offset_origin(l, p, ng, wi_world), &mut c.next_origin, base);
+}
+
+/// `bsdf::DielectricFresnel` over lanes.
+pub(super) struct Fresnel<F> {
+    pub reflectance: F,
+    pub cos_t: F,
+    pub eta_ti: F,
+}
+
+/// `bsdf::fresnel_dielectric`, in its operations and branches (as selects).
+#[inline(always)]
+pub(super) fn fresnel_dielectric<L: Lanes>(l: L, cos_i: L::F, eta: L::F) -> Fresnel<L::F> {
+    let (zero, one) = (l.splat(0.0), l.splat(1.0));
+    let front = l.ge(cos_i, zero);
+    let eta_ti = l.select(front, eta, l.div(one, eta));
+    let ci = l.abs(cos_i);
+    let sin2_t = l.div(l.sub(one, l.mul(ci, ci)), l.mul(eta_ti, eta_ti));
+    let total = l.ge(sin2_t, one);
+    // `(1 - sin2_t).max(0.0)`: never -0.0, and `Lanes::max` gives 0 on NaN as `f32::max` does.
+    let ct = l.sqrt(l.max(l.sub(one, sin2_t), zero));
+    let rs = l.div(l.sub(ci, l.mul(eta_ti, ct)), l.add(ci, l.mul(eta_ti, ct)));
+    let rp = l.div(l.sub(l.mul(eta_ti, ci), ct), l.add(l.mul(eta_ti, ci), ct));
+    let f = l.mul(l.splat(0.5), l.add(l.mul(rs, rs), l.mul(rp, rp)));
+    let cos_t = l.select(front, l.neg(ct), ct);
+    // eta == 1 first, then total internal reflection.
+    let index_matched = l.eq(eta, one);
+    Fresnel {
+        reflectance: l.select(index_matched, zero, l.select(total, one, f)),
+        cos_t: l.select(index_matched, l.neg(cos_i), l.select(total, zero, cos_t)),
+        eta_ti: l.select(index_matched, one, eta_ti),
+    }
+}
+
+/// `bsdf::fresnel_conductor` for one channel, in its operations.
+#[inline(always)]
+fn fresnel_conductor<L: Lanes>(l: L, cos_i: L::F, eta: L::F, k: L::F) -> L::F {
+    let (zero, one, half) = (l.splat(0.0), l.splat(1.0), l.splat(0.5));
+    // `cos_i.clamp(0.0, 1.0)`: NaN stays NaN (`Lanes::max`/`min` would make it a bound).
+    let c = l.select(l.lt(cos_i, zero), zero, l.select(l.gt(cos_i, one), one, cos_i));
+    let c2 = l.mul(c, c);
+    let s2 = l.sub(one, c2);
+    let eta2 = l.mul(eta, eta);
+    let k2 = l.mul(k, k);
+    let t0 = l.sub(l.sub(eta2, k2), s2);
+    // `.max(0.0)` of sums that are never -0.0: `Lanes::max` agrees with `f32::max` (0 on NaN).
+    let a2b2 = l.sqrt(l.max(l.add(l.mul(t0, t0), l.mul(l.mul(l.splat(4.0), eta2), k2)), zero));
+    let t1 = l.add(a2b2, c2);
+    let a = l.sqrt(l.max(l.mul(half, l.add(a2b2, t0)), zero));
+    let t2 = l.mul(l.mul(l.splat(2.0), c), a);
+    let rs = l.div(l.sub(t1, t2), l.add(t1, t2));
+    let t3 = l.add(l.mul(c2, a2b2), l.mul(s2, s2));
+    let t4 = l.mul(t2, s2);
+    let rp = l.div(l.mul(rs, l.sub(t3, t4)), l.add(t3, t4));
+    let r = l.mul(half, l.add(rp, rs));
+    l.select(l.lt(l.abs(r), l.splat(f32::INFINITY)), r, one)
+}
