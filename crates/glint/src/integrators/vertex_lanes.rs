@@ -7,7 +7,9 @@
 //! them; the lanes then evaluate the BSDF towards the light, weight it by MIS, build the
 //! shadow ray, sample the BSDF and spawn the next ray; per path again, the results go back
 //! into the path (`PathState::go_on`, Russian roulette). Lanes hold structure-of-arrays
-//! state in a chunk on the stack: written once, read once, in L1.
+//! state in a chunk per BSDF class on the stack (the wave's paths are binned by class as they
+//! arrive): written once, read once, in L1. On untransformed meshes of a constant Lambertian
+//! material the lanes compute the interaction's normals and frame too ([`MeshHit`]).
 //!
 //! **Bit identity.** Each lane computes exactly what `PathState::scatter` computes for its
 //! path: the same IEEE operations in the same order (Rust never contracts to FMA), the
@@ -17,9 +19,10 @@
 //! inputs; `tests/wavefront.rs` renders every test scene under every schedule and compares the
 //! bits.
 //!
-//! Covered so far: the Lambertian BSDF without normal or bump maps (`Bsdf::Diffuse`), the
-//! BSDF of the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`. Every
-//! other BSDF steps through `PathState::scatter`, one path at a time.
+//! Covered so far, without normal or bump maps: the Lambertian BSDF (`diffuse`: the BSDF of
+//! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), and the smooth
+//! conductor and dielectric (`smooth`). Every other BSDF steps through `PathState::scatter`,
+//! one path at a time.
 
 mod diffuse;
 mod lane_math;
@@ -39,7 +42,7 @@ use crate::math::lanes::{Avx2x8, Avx512x16};
 use crate::math::lanes::{Lanes, One, MAX_LANES};
 use crate::math::{vec3, Rgb, Vec3};
 use crate::sampling::Sampler;
-use crate::world::{Hit, ShapeRef, World};
+use crate::world::{barycentric_point, Hit, ShapeRef, World};
 use diffuse::DiffuseChunk;
 use smooth::{Smooth, SmoothChunk};
 
@@ -130,8 +133,7 @@ impl MeshHit {
         let tri = hit.prim as usize;
         let [i0, i1, i2] = *mesh.indices.get(tri)?;
         let [a, b, c] = mesh.vertices(tri);
-        let b0 = 1.0 - hit.b1 - hit.b2;
-        let p = a * b0 + b * hit.b1 + c * hit.b2;
+        let (p, b0) = barycentric_point([a, b, c], hit.b1, hit.b2);
         let (i0, i1, i2) = (i0 as usize, i1 as usize, i2 as usize);
         let at = MeshHit {
             corners: [a, b, c],

@@ -782,8 +782,7 @@ impl TriangleSurface {
         b1: f32,
         b2: f32,
     ) -> TriangleSurface {
-        let b0 = 1.0 - b1 - b2;
-        let p = a * b0 + b * b1 + c * b2;
+        let (p, b0) = barycentric_point([a, b, c], b1, b2);
         let ng = (b - a).cross(c - a);
         let ns = normals.map(|n| n[0] * b0 + n[1] * b1 + n[2] * b2);
         let (uv, dpdu, dpdv) = match uvs {
@@ -796,6 +795,13 @@ impl TriangleSurface {
         };
         TriangleSurface { p, ng, ns, uv, dpdu, dpdv }
     }
+}
+
+/// The point at barycentrics (b1, b2) of a triangle, and the first barycentric.
+#[inline(always)]
+pub(crate) fn barycentric_point([a, b, c]: [Vec3; 3], b1: f32, b2: f32) -> (Vec3, f32) {
+    let b0 = 1.0 - b1 - b2;
+    (a * b0 + b * b1 + c * b2, b0)
 }
 
 /// The unit geometric normal and the shading normal of a hit from the shape's normal `ng`
