@@ -8,8 +8,9 @@
 //!   with every strategy, hidden emitters, depth limits and fixed Russian roulette on a scene
 //!   with glass, metal and instances, at tile sizes and sample counts that fill, split and
 //!   leave part-full waves; and every Mitsuba agreement scene (masks, textures, media,
-//!   instances, every light) as its file asks. (Every statistical test that renders through
-//!   `common::scenes::render_with` also checks every schedule.)
+//!   instances, every light), every bundled scene and every bench scene as its file asks.
+//!   (Every statistical test that renders through `common::scenes::render_with` also checks
+//!   every schedule.)
 
 mod common;
 
@@ -154,16 +155,25 @@ fn a_large_mesh_gives_the_same_bits_on_every_schedule_with_hit_prefetching() {
     waves.iter().for_each(|w| assert_same_bits(&one, w));
 }
 
-#[test]
-fn every_agreement_scene_gives_the_same_bits_on_every_schedule() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/scenes/mitsuba");
+/// The scene files (`.xml`, `.json`) in `dir`, relative to the repository root, sorted.
+fn scene_files(dir: &str) -> Vec<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(dir);
     let mut files: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "xml"))
+        .filter(|p| p.extension().is_some_and(|e| e == "xml" || e == "json"))
         .collect();
     files.sort();
-    assert!(files.len() >= 30, "expected the agreement scenes in {}", dir.display());
+    files
+}
+
+#[test]
+fn every_agreement_bundled_and_bench_scene_gives_the_same_bits_on_every_schedule() {
+    let agreement = scene_files("tests/scenes/mitsuba");
+    assert!(agreement.len() >= 30, "expected the agreement scenes");
+    let bundled = scene_files("scenes");
+    assert!(bundled.len() >= 4, "expected the bundled scenes");
+    let files: Vec<_> = agreement.into_iter().chain(bundled).chain(scene_files("bench/scenes")).collect();
     for f in &files {
         // Small images (a cropped film keeps its own size: its crop window needs it).
         let loaded = load(f, &[], Some((24, 18))).or_else(|_| load(f, &[], None)).unwrap();
