@@ -24,6 +24,7 @@
 //! conductor and dielectric (`smooth`). Every other BSDF steps through `PathState::scatter`,
 //! one path at a time.
 
+mod columns;
 mod diffuse;
 mod lane_math;
 mod smooth;

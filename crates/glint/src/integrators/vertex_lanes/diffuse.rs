@@ -3,11 +3,12 @@
 //! shadow ray, the cosine sample and the next ray (`diffuse_lanes`), as
 //! `PathState::scatter` computes them for `Bsdf::Diffuse`.
 
+use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
 use super::{flag, get3, put3, Column, Column3, LaneIsa, MeshHit};
 use crate::describe::{PathSettings, Strategy};
 use crate::integrators::estimators::PrevEvent;
-use crate::integrators::path::{PathState, ShadowQuery};
+use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 #[cfg(target_arch = "x86_64")]
@@ -24,22 +25,11 @@ pub(crate) struct DiffuseChunk {
     pub len: usize,
     /// Which path each lane is (the caller's index).
     pub path: [u32; MAX_LANES],
-    // In: the vertex.
-    pub(super) dir: Column3,
-    pub(super) p: Column3,
-    pub(super) ng: Column3,
-    pub(super) n: Column3,
-    pub(super) s: Column3,
-    pub(super) t: Column3,
+    pub(super) v: VertexColumns,
     pub(super) reflectance: Column3,
     pub(super) throughput: Column3,
-    // In: the light sample (`has_light` 0 where there is none).
-    pub(super) has_light: Column,
-    pub(super) light_wi: Column3,
-    pub(super) light_dist: Column,
-    pub(super) light_radiance: Column3,
-    pub(super) light_pdf: Column,
-    pub(super) light_delta: Column,
+    /// The light sample in, the shadow ray out.
+    pub(super) ne: NextEventColumns,
     // In: the BSDF's square sample.
     pub(super) u: [Column; 2],
     // In, for lanes whose interaction the kernel computes (`from_mesh` 1): the hit triangle of
@@ -54,13 +44,6 @@ pub(crate) struct DiffuseChunk {
     pub(super) uvs: [[Column; 2]; 3],
     pub(super) flip_normals: Column,
     pub(super) two_sided: Column,
-    // Out: the shadow ray (`shadow` 0 where there is none).
-    pub(super) shadow: Column,
-    pub(super) shadow_origin: Column3,
-    pub(super) shadow_dir: Column3,
-    pub(super) shadow_t_max: Column,
-    pub(super) contribution: Column3,
-    pub(super) mis_weight: Column,
     // Out: the next ray (`sampled` 0 where the path ends).
     pub(super) sampled: Column,
     pub(super) next_origin: Column3,
@@ -89,10 +72,7 @@ impl DiffuseChunk {
     ) {
         let i = self.push_common(path_index, path, si.p, reflectance, light, rng);
         self.from_mesh[i] = 0.0;
-        put3(&mut self.ng, i, [si.ng.x, si.ng.y, si.ng.z]);
-        put3(&mut self.n, i, [frame.n.x, frame.n.y, frame.n.z]);
-        put3(&mut self.s, i, [frame.s.x, frame.s.y, frame.s.z]);
-        put3(&mut self.t, i, [frame.t.x, frame.t.y, frame.t.z]);
+        self.v.put_frame(i, si.ng, frame);
     }
 
     /// Adds a path's vertex on an untransformed mesh as the next lane, its interaction and
@@ -142,30 +122,10 @@ impl DiffuseChunk {
         let i = self.len;
         self.len += 1;
         self.path[i] = path_index;
-        let d = path.ray.dir;
-        put3(&mut self.dir, i, [d.x, d.y, d.z]);
-        put3(&mut self.p, i, [p.x, p.y, p.z]);
+        self.v.put_ray(i, path.ray.dir, p);
         put3(&mut self.reflectance, i, reflectance.to_array());
         put3(&mut self.throughput, i, path.throughput().to_array());
-        match light {
-            Some((ls, pick_pmf)) => {
-                self.has_light[i] = 1.0;
-                put3(&mut self.light_wi, i, [ls.wi.x, ls.wi.y, ls.wi.z]);
-                self.light_dist[i] = ls.dist;
-                put3(&mut self.light_radiance, i, ls.radiance.to_array());
-                self.light_pdf[i] = pick_pmf * ls.pdf;
-                self.light_delta[i] = flag(ls.delta);
-            }
-            None => {
-                // Finite values in the unused lanes: nothing is computed from them.
-                self.has_light[i] = 0.0;
-                put3(&mut self.light_wi, i, [0.0, 0.0, 1.0]);
-                self.light_dist[i] = 1.0;
-                put3(&mut self.light_radiance, i, [0.0; 3]);
-                self.light_pdf[i] = 1.0;
-                self.light_delta[i] = 0.0;
-            }
-        }
+        self.ne.put(i, light);
         let _u_lobe = rng.next_f32();
         let u = rng.next_2d();
         self.u[0][i] = u[0];
@@ -189,22 +149,12 @@ impl DiffuseChunk {
 
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
-        if self.shadow[i] != 0.0 {
-            path.leave_shadow_ray(
-                ShadowQuery {
-                    ray: Ray::segment(get3(&self.shadow_origin, i), get3(&self.shadow_dir, i), self.shadow_t_max[i]),
-                    contribution: Rgb::from_array(get3(&self.contribution, i).to_array()),
-                    mis_weight: self.mis_weight[i],
-                    light_pdf: self.light_pdf[i],
-                },
-                c,
-            );
-        }
+        self.ne.finish(i, path, c);
         if self.sampled[i] == 0.0 {
             return;
         }
         let weight = Rgb::from_array(get3(&self.reflectance, i).to_array());
-        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.p, i) };
+        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.v.p, i) };
         let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
         path.go_on(s, weight, 1.0, prev, ray, rng);
     }
@@ -242,19 +192,17 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, light_only: 
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let inv_pi = l.splat(INV_PI);
-    let dir = load3(l, &c.dir, base);
-    let p = load3(l, &c.p, base);
-    let ng = load3(l, &c.ng, base);
-    let n = load3(l, &c.n, base);
+    let dir = load3(l, &c.v.dir, base);
+    let n = load3(l, &c.v.n, base);
     let refl = load3(l, &c.reflectance, base);
     let thr = load3(l, &c.throughput, base);
     // `frame.to_local(-ray.dir).z`: the Lambertian BSDF reads only the normal component.
     let wo_z = dot(l, V3 { x: l.neg(dir.x), y: l.neg(dir.y), z: l.neg(dir.z) }, n);
     let wo_below = l.le(wo_z, zero);
 
-    // Next-event estimation: `Diffuse::eval` and `pdf` towards the light, the MIS weight,
-    // the contribution and the shadow ray.
-    let light_wi = load3(l, &c.light_wi, base);
+    // Next-event estimation: `Diffuse::eval` and `pdf` towards the light, then what
+    // `NextEventColumns::lanes` makes of them.
+    let light_wi = load3(l, &c.ne.light_wi, base);
     let wi_z = dot(l, light_wi, n);
     let black = l.or(wo_below, l.le(wi_z, zero));
     let k = l.mul(inv_pi, wi_z);
@@ -265,32 +213,7 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, light_only: 
     };
     // `cosine_hemisphere_pdf(wi.z)`: `wi.z.max(0.0)`, where `Lanes::max` agrees (0 on NaN).
     let bsdf_pdf = l.select(black, zero, l.mul(l.max(wi_z, zero), inv_pi));
-    let f_black = l.and(l.and(l.eq(f.x, zero), l.eq(f.y, zero)), l.eq(f.z, zero));
-    let light_pdf = l.load(&c.light_pdf[base..]);
-    // `power_heuristic(light_pdf, bsdf_pdf)`.
-    let a = l.mul(light_pdf, light_pdf);
-    let b = l.mul(bsdf_pdf, bsdf_pdf);
-    let sum = l.add(a, b);
-    let heuristic = l.select(l.eq(a, l.splat(f32::INFINITY)), one, l.select(l.eq(sum, zero), zero, l.div(a, sum)));
-    let delta = l.gt(l.load(&c.light_delta[base..]), zero);
-    let mis = if light_only { one } else { l.select(delta, one, heuristic) };
-    let has_light = l.gt(l.load(&c.has_light[base..]), zero);
-    let shadow = l.and_not(has_light, f_black);
-    let radiance = load3(l, &c.light_radiance, base);
-    store3(l, mul3(l, mul3(l, thr, f), radiance), &mut c.contribution, base);
-    l.store(mis, &mut c.mis_weight[base..]);
-    l.store(l.select(shadow, one, zero), &mut c.shadow[base..]);
-    // `shadow_ray(si, ls.wi, ls.dist)`.
-    let dist = l.load(&c.light_dist[base..]);
-    let o = offset_origin(l, p, ng, light_wi);
-    let to_target = sub3(l, add3(l, p, scale(l, light_wi, dist)), o);
-    let len = l.sqrt(dot(l, to_target, to_target));
-    let toward = scale(l, to_target, l.div(one, len));
-    let finite = l.lt(l.abs(dist), l.splat(f32::INFINITY));
-    store3(l, o, &mut c.shadow_origin, base);
-    store3(l, select3(l, finite, toward, light_wi), &mut c.shadow_dir, base);
-    let t_max = l.mul(len, l.splat(1.0 - 1e-4));
-    l.store(l.select(finite, t_max, l.splat(f32::INFINITY)), &mut c.shadow_t_max[base..]);
+    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
 
     // `Diffuse::sample`: `cosine_hemisphere(u)` by `concentric_disk`, in its operations.
     let u0 = l.load(&c.u[0][base..]);
@@ -313,11 +236,9 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, light_only: 
     l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
     l.store(l.mul(l.max(z, zero), inv_pi), &mut c.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
-    let s = load3(l, &c.s, base);
-    let t = load3(l, &c.t, base);
-    let wi = add3(l, add3(l, scale(l, s, dx), scale(l, t, dy)), scale(l, n, z));
+    let wi = c.v.world(l, base, V3 { x: dx, y: dy, z });
     store3(l, wi, &mut c.next_dir, base);
-    store3(l, offset_origin(l, p, ng, wi), &mut c.next_origin, base);
+    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next_origin, base);
 }
 
 /// For the lanes of untransformed meshes: `World::interaction`'s geometric normal and
@@ -372,16 +293,17 @@ fn mesh_frames<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize) {
     let s = select3(l, tangent_ok, s_unit, basis_s);
     let t = select3(l, tangent_ok, cross(l, n_shading, s_unit), basis_t);
     // `shading`: a two-sided material's frame faces the viewer (`-ray.dir`).
-    let dir = load3(l, &c.dir, base);
+    let dir = load3(l, &c.v.dir, base);
     let facing_away = l.lt(dot(l, n_shading, neg3(l, dir)), zero);
     let turn = l.and(yes(&c.two_sided), facing_away);
     let n = select3(l, turn, neg3(l, n_shading), n_shading);
+    let v = &mut c.v;
     let keep = |new: V3<L::F>, col: &Column3| select3(l, from_mesh, new, load3(l, col, base));
-    let (ng, n, s, t) = (keep(ng, &c.ng), keep(n, &c.n), keep(s, &c.s), keep(t, &c.t));
-    store3(l, ng, &mut c.ng, base);
-    store3(l, n, &mut c.n, base);
-    store3(l, s, &mut c.s, base);
-    store3(l, t, &mut c.t, base);
+    let (ng, n, s, t) = (keep(ng, &v.ng), keep(n, &v.n), keep(s, &v.s), keep(t, &v.t));
+    store3(l, ng, &mut v.ng, base);
+    store3(l, n, &mut v.n, base);
+    store3(l, s, &mut v.s, base);
+    store3(l, t, &mut v.t, base);
 }
 
 /// `warp::sin_cos_quarter`, in its operations and constants.

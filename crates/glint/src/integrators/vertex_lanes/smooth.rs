@@ -3,6 +3,7 @@
 //! `Bsdf::Dielectric` (the dielectric Fresnel term, reflection or refraction chosen by the
 //! lobe number): no light sample, no shadow ray, the next ray.
 
+use super::columns::VertexColumns;
 use super::lane_math::*;
 use super::{get3, put3, Column, Column3, LaneIsa};
 use crate::describe::PathSettings;
@@ -28,13 +29,8 @@ pub(crate) enum Smooth {
 pub(crate) struct SmoothChunk {
     pub len: usize,
     pub path: [u32; MAX_LANES],
-    // In: the vertex and the conductor.
-    pub(super) dir: Column3,
-    pub(super) p: Column3,
-    pub(super) ng: Column3,
-    pub(super) n: Column3,
-    pub(super) s: Column3,
-    pub(super) t: Column3,
+    // In: the vertex and the BSDF.
+    pub(super) v: VertexColumns,
     /// 1 for a dielectric, 0 for a conductor.
     pub(super) glass: Column,
     /// The conductor's eta, k and specular reflectance; the dielectric's eta (in the first
@@ -71,13 +67,8 @@ impl SmoothChunk {
         let i = self.len;
         self.len += 1;
         self.path[i] = path_index;
-        let d = path.ray.dir;
-        put3(&mut self.dir, i, [d.x, d.y, d.z]);
-        put3(&mut self.p, i, [si.p.x, si.p.y, si.p.z]);
-        put3(&mut self.ng, i, [si.ng.x, si.ng.y, si.ng.z]);
-        put3(&mut self.n, i, [frame.n.x, frame.n.y, frame.n.z]);
-        put3(&mut self.s, i, [frame.s.x, frame.s.y, frame.s.z]);
-        put3(&mut self.t, i, [frame.t.x, frame.t.y, frame.t.z]);
+        self.v.put_ray(i, path.ray.dir, si.p);
+        self.v.put_frame(i, si.ng, frame);
         match bsdf {
             Smooth::Conductor(m) => {
                 self.glass[i] = 0.0;
@@ -117,7 +108,7 @@ impl SmoothChunk {
             return;
         }
         let weight = Rgb::from_array(get3(&self.weight, i).to_array());
-        let prev = PrevEvent { pdf: 1.0, delta: true, p: get3(&self.p, i) };
+        let prev = PrevEvent { pdf: 1.0, delta: true, p: get3(&self.v.p, i) };
         let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
         path.go_on(s, weight, self.eta_out[i], prev, ray, rng);
     }
@@ -151,10 +142,7 @@ fn smooth_chunk<L: Lanes>(l: L, c: &mut SmoothChunk) {
 #[inline(always)]
 fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize) {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
-    let wo_world = neg3(l, load3(l, &c.dir, base));
-    let (s, t, n) = (load3(l, &c.s, base), load3(l, &c.t, base), load3(l, &c.n, base));
-    // `frame.to_local(wo)`.
-    let wo = V3 { x: dot(l, wo_world, s), y: dot(l, wo_world, t), z: dot(l, wo_world, n) };
+    let wo = c.v.wo_local(l, base);
     let (eta, spec) = (load3(l, &c.eta, base), load3(l, &c.specular, base));
     let glass = l.gt(l.load(&c.glass[base..]), zero);
     let mirror = l.not(glass);
@@ -188,10 +176,9 @@ fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize) {
     l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
     store3(l, weight, &mut c.weight, base);
     l.store(eta_out, &mut c.eta_out[base..]);
-    let wi_world = add3(l, add3(l, scale(l, s, wi.x), scale(l, t, wi.y)), scale(l, n, wi.z));
+    let wi_world = c.v.world(l, base, wi);
     store3(l, wi_world, &mut c.next_dir, base);
-    let (p, ng) = (load3(l, &c.p, base), load3(l, &c.ng, base));
-    store3(l, offset_origin(l, p, ng, wi_world), &mut c.next_origin, base);
+    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next_origin, base);
 }
 
 /// `bsdf::DielectricFresnel` over lanes.

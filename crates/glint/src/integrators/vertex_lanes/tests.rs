@@ -97,33 +97,23 @@ fn reference(v: &Vertex, light_only: bool) -> Outcome {
 
 fn fill(c: &mut DiffuseChunk, i: usize, v: &Vertex) {
     c.len = c.len.max(i + 1);
-    put3(&mut c.dir, i, [v.dir.x, v.dir.y, v.dir.z]);
-    put3(&mut c.p, i, [v.p.x, v.p.y, v.p.z]);
-    put3(&mut c.ng, i, [v.ng.x, v.ng.y, v.ng.z]);
-    put3(&mut c.n, i, [v.frame.n.x, v.frame.n.y, v.frame.n.z]);
-    put3(&mut c.s, i, [v.frame.s.x, v.frame.s.y, v.frame.s.z]);
-    put3(&mut c.t, i, [v.frame.t.x, v.frame.t.y, v.frame.t.z]);
+    c.v.put_ray(i, v.dir, v.p);
+    c.v.put_frame(i, v.ng, &v.frame);
     put3(&mut c.reflectance, i, v.reflectance.to_array());
     put3(&mut c.throughput, i, v.throughput.to_array());
-    c.has_light[i] = flag(v.light.is_some());
-    let ls = v.light.unwrap_or(LightSample { wi: Vec3::Z, radiance: Rgb::BLACK, pdf: 1.0, dist: 1.0, delta: false });
-    put3(&mut c.light_wi, i, [ls.wi.x, ls.wi.y, ls.wi.z]);
-    c.light_dist[i] = ls.dist;
-    put3(&mut c.light_radiance, i, ls.radiance.to_array());
-    c.light_pdf[i] = v.pick_pmf * ls.pdf;
-    c.light_delta[i] = flag(ls.delta);
+    c.ne.put(i, v.light.map(|ls| (ls, v.pick_pmf)));
     c.u[0][i] = v.u[0];
     c.u[1][i] = v.u[1];
 }
 
 fn outcome(c: &DiffuseChunk, i: usize) -> Outcome {
-    let shadow = (c.shadow[i] != 0.0).then(|| {
+    let shadow = (c.ne.shadow[i] != 0.0).then(|| {
         (
-            bits(get3(&c.shadow_origin, i)),
-            bits(get3(&c.shadow_dir, i)),
-            bits1(c.shadow_t_max[i]),
-            bits(get3(&c.contribution, i)),
-            bits1(c.mis_weight[i]),
+            bits(get3(&c.ne.shadow_origin, i)),
+            bits(get3(&c.ne.shadow_dir, i)),
+            bits1(c.ne.shadow_t_max[i]),
+            bits(get3(&c.ne.contribution, i)),
+            bits1(c.ne.mis_weight[i]),
         )
     });
     let next =
@@ -308,7 +298,7 @@ fn check_mesh_frames(isa: LaneIsa) {
         chunk.len = lanes;
         chunk.run(isa, Strategy::Mis);
         for (i, (ng, frame)) in want.iter().enumerate() {
-            let got = [get3(&chunk.ng, i), get3(&chunk.n, i), get3(&chunk.s, i), get3(&chunk.t, i)].map(bits);
+            let got = [get3(&chunk.v.ng, i), get3(&chunk.v.n, i), get3(&chunk.v.s, i), get3(&chunk.v.t, i)].map(bits);
             let expected = [*ng, frame.n, frame.s, frame.t].map(bits);
             assert_eq!(got, expected, "{isa:?} lane {i}, round {round}");
         }
