@@ -20,13 +20,14 @@
 //! bits.
 //!
 //! Covered so far, without normal or bump maps: the Lambertian BSDF (`diffuse`: the BSDF of
-//! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), and the smooth
-//! conductor and dielectric (`smooth`). Every other BSDF steps through `PathState::scatter`,
-//! one path at a time.
+//! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), the smooth
+//! conductor and dielectric (`smooth`), and the principled BSDF with all its lobes
+//! (`principled`). Every other BSDF steps through `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
 mod lane_math;
+mod principled;
 mod smooth;
 
 use super::estimators::sample_light;
@@ -45,6 +46,7 @@ use crate::math::{vec3, Rgb, Vec3};
 use crate::sampling::Sampler;
 use crate::world::{barycentric_point, Hit, ShapeRef, World};
 use diffuse::DiffuseChunk;
+use principled::PrincipledChunk;
 use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
@@ -158,11 +160,18 @@ pub(crate) struct LaneStepper {
     /// One chunk per BSDF class: a chunk's lanes run one kernel.
     chunk: DiffuseChunk,
     smooth: SmoothChunk,
+    principled: PrincipledChunk,
 }
 
 impl LaneStepper {
     pub fn new(isa: LaneIsa) -> LaneStepper {
-        LaneStepper { isa, lanes: isa.lanes(), chunk: DiffuseChunk::default(), smooth: SmoothChunk::default() }
+        LaneStepper {
+            isa,
+            lanes: isa.lanes(),
+            chunk: DiffuseChunk::default(),
+            smooth: SmoothChunk::default(),
+            principled: PrincipledChunk::default(),
+        }
     }
 
     /// Path `i`'s step at `hit`; its results may wait until the chunk runs (at the latest at
@@ -208,6 +217,14 @@ impl LaneStepper {
             }
             return;
         }
+        if let (Bsdf::Principled(b), None) = (&bsdf.bsdf, &bsdf.tilt) {
+            let light = self.light_sample(s, scene, si.p, rng);
+            self.principled.push(i as u32, path, &si, &frame, b, light, rng);
+            if self.principled.is_full(self.lanes) {
+                self.flush_principled(s, paths, samples, c);
+            }
+            return;
+        }
         let Some(reflectance) = plain_diffuse(&bsdf) else {
             path.scatter(s, scene, &si, &bsdf, &frame, rng, c, &mut Unobserved);
             return;
@@ -233,6 +250,25 @@ impl LaneStepper {
     pub fn flush(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample], c: &mut Counters) {
         self.flush_diffuse(s, paths, samples, c);
         self.flush_smooth(s, paths, samples);
+        self.flush_principled(s, paths, samples, c);
+    }
+
+    fn flush_principled(
+        &mut self,
+        s: &PathSettings,
+        paths: &mut [PathState],
+        samples: &mut [CameraSample],
+        c: &mut Counters,
+    ) {
+        if self.principled.len == 0 {
+            return;
+        }
+        self.principled.run(self.isa, s.strategy);
+        for lane in 0..self.principled.len {
+            let i = self.principled.path[lane] as usize;
+            self.principled.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
+        }
+        self.principled.len = 0;
     }
 
     fn flush_smooth(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample]) {

@@ -7,10 +7,11 @@
 //! and the film discards a sample that is not finite.
 
 use super::diffuse::DiffuseChunk;
+use super::principled::PrincipledChunk;
 use super::smooth::{Smooth, SmoothChunk};
 use super::*;
 use crate::integrators::{shadow_ray, spawn_ray};
-use crate::materials::{Bsdf, Conductor, Dielectric, Diffuse};
+use crate::materials::{Bsdf, Conductor, Dielectric, Diffuse, Principled, PrincipledInputs, PrincipledRates};
 use crate::math::{Frame, Ray};
 use crate::sampling::{power_heuristic, Rng};
 use crate::world::SurfaceInteraction;
@@ -433,6 +434,137 @@ fn every_lane_finds_the_dielectric_fresnel_term_of_the_one_path_code() {
         }
         if let Some(l) = Avx512x16::new() {
             check_fresnel_dielectric(l);
+        }
+    }
+}
+
+/// The one-path code's whole step at `v` for a BSDF that is not delta: the shadow ray, then
+/// the sample (origin, direction, weight, density, eta) that `scatter` keeps.
+type SampleBits = ([u32; 3], [u32; 3], [u32; 3], u32, u32);
+
+fn reference_scatter(
+    v: &Vertex,
+    bsdf: &Bsdf,
+    u_lobe: f32,
+    u: [f32; 2],
+    light_only: bool,
+) -> (Option<ShadowBits>, Option<SampleBits>) {
+    let si = surface(v);
+    let wo = v.frame.to_local(-v.dir);
+    let mut shadow = None;
+    if let Some(ls) = v.light {
+        let wi = v.frame.to_local(ls.wi);
+        let f = bsdf.eval(wo, wi);
+        if !f.is_black() {
+            let light_pdf = v.pick_pmf * ls.pdf;
+            let mis = if ls.delta || light_only { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
+            let r = shadow_ray(&si, ls.wi, ls.dist);
+            let c = v.throughput * f * ls.radiance;
+            shadow = Some((bits(r.origin), bits(r.dir), bits1(r.t_max), bits(vec3(c.r, c.g, c.b)), bits1(mis)));
+        }
+    }
+    let next = bsdf.sample(wo, u_lobe, u).filter(|bs| !bs.weight.is_black()).map(|bs| {
+        let r = spawn_ray(&si, v.frame.to_world(bs.wi));
+        (bits(r.origin), bits(r.dir), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)), bits1(bs.pdf), bits1(bs.eta))
+    });
+    (shadow, next)
+}
+
+fn random_principled(rng: &mut Rng) -> Principled {
+    // Each parameter at its bounds now and then (the lobes' `if`s), else inside them.
+    let unit = |rng: &mut Rng| match rng.next_u32() % 6 {
+        0 => 0.0,
+        1 => 1.0,
+        _ => rng.next_f32(),
+    };
+    let base_color =
+        if rng.next_u32().is_multiple_of(12) { Rgb::BLACK } else { Rgb::from_array([unit(rng), unit(rng), unit(rng)]) };
+    let eta = match rng.next_u32() % 5 {
+        0 => 1.0,
+        1 => 1.0 / 1.5,
+        _ => 1.0 + 1.5 * rng.next_f32(),
+    };
+    Principled::new(&PrincipledInputs {
+        base_color,
+        roughness: unit(rng),
+        anisotropic: unit(rng),
+        metallic: unit(rng),
+        spec_trans: unit(rng),
+        eta,
+        spec_tint: unit(rng),
+        sheen: unit(rng),
+        sheen_tint: unit(rng),
+        flatness: unit(rng),
+        clearcoat: unit(rng),
+        clearcoat_gloss: unit(rng),
+        rates: PrincipledRates { diffuse: unit(rng), specular: 1.0, clearcoat: unit(rng) },
+    })
+}
+
+fn check_principled(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(41, lanes as u64);
+    let (mut shadows, mut kept, mut refracted, mut total) = (0, 0, 0, 0);
+    for round in 0..3000 {
+        let light_only = round % 5 == 0;
+        let mut chunk = PrincipledChunk::default();
+        let mut want = Vec::new();
+        let used = if round % 7 == 0 { 1 + round % lanes } else { lanes };
+        for i in 0..used {
+            // A new path's throughput (1): the product is the diffuse test's.
+            let v = Vertex { throughput: Rgb::WHITE, ..vertex(&mut rng) };
+            let b = random_principled(&mut rng);
+            let si = surface(&v);
+            let mut sampler = Sampler::from_rng(Rng::new(3, (round * lanes + i) as u64));
+            let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
+            chunk.push(i as u32, &path, &si, &v.frame, &b, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
+            let u = [chunk.u[0][i], chunk.u[1][i]];
+            want.push((reference_scatter(&v, &Bsdf::Principled(b), chunk.u_lobe[i], u, light_only), v, b));
+        }
+        chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
+        for (i, (w, v, b)) in want.iter().enumerate() {
+            let c = &chunk;
+            let shadow = (c.ne.shadow[i] != 0.0).then(|| {
+                (
+                    bits(get3(&c.ne.shadow_origin, i)),
+                    bits(get3(&c.ne.shadow_dir, i)),
+                    bits1(c.ne.shadow_t_max[i]),
+                    bits(get3(&c.ne.contribution, i)),
+                    bits1(c.ne.mis_weight[i]),
+                )
+            });
+            let next = (c.sampled[i] != 0.0).then(|| {
+                (
+                    bits(get3(&c.next_origin, i)),
+                    bits(get3(&c.next_dir, i)),
+                    bits(get3(&c.weight, i)),
+                    bits1(c.pdf[i]),
+                    bits1(c.eta_out[i]),
+                )
+            });
+            assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {b:?}");
+            total += 1;
+            shadows += w.0.is_some() as u32;
+            kept += w.1.is_some() as u32;
+            refracted += w.1.is_some_and(|n| n.4 != 1.0f32.to_bits()) as u32;
+        }
+    }
+    assert!(
+        shadows > total / 10 && kept > total / 4 && kept < total && refracted > total / 50,
+        "{isa:?}: {shadows} shadow rays, {kept} samples ({refracted} refracted) of {total}"
+    );
+}
+
+#[test]
+fn every_lane_scatters_off_the_principled_bsdf_as_the_one_path_code_does() {
+    check_principled(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check_principled(LaneIsa::Avx2);
+        }
+        if Avx512x16::new().is_some() {
+            check_principled(LaneIsa::Avx512);
         }
     }
 }
