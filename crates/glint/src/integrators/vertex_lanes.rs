@@ -14,19 +14,25 @@
 //! **Bit identity.** Each lane computes exactly what `PathState::scatter` computes for its
 //! path: the same IEEE operations in the same order (Rust never contracts to FMA), the
 //! `Lanes` min/max only where the scalar code's `f32::max`/`min` give the same answer (noted
-//! at each use), and no libm calls (the concentric disk's sine and cosine are polynomials in
-//! both). `tests` below compares each lane with the one-path code on random and special
-//! inputs; `tests/wavefront.rs` renders every test scene under every schedule and compares the
-//! bits.
+//! at each use), and no libm in vector form: the concentric disk's sine and cosine are
+//! polynomials in both, and where the scalar code calls libm (`f32::cos`, `f32::exp`, f64's
+//! error function) the lanes make the same scalar call for each lane. `tests` below compares
+//! each lane with the one-path code on random and special inputs; `tests/wavefront.rs`
+//! renders every test scene under every schedule and compares the bits.
 //!
 //! Covered so far, without normal or bump maps: the Lambertian BSDF (`diffuse`: the BSDF of
-//! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), and the smooth
-//! conductor and dielectric (`smooth`). Every other BSDF steps through `PathState::scatter`,
-//! one path at a time.
+//! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), the smooth
+//! conductor and dielectric (`smooth`), and the rough conductor (`rough`: GGX and Beckmann,
+//! isotropic or anisotropic, over the lanes' microfacet distribution in `microfacet`, which
+//! makes the scalar calls of libm's sine, cosine and exponential and of Beckmann's f64 visible
+//! fraction and visible-normal sampling per lane: the same calls, so the same bits). Every
+//! other BSDF steps through `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
 mod lane_math;
+mod microfacet;
+mod rough;
 mod smooth;
 
 use super::estimators::sample_light;
@@ -45,6 +51,7 @@ use crate::math::{vec3, Rgb, Vec3};
 use crate::sampling::Sampler;
 use crate::world::{barycentric_point, Hit, ShapeRef, World};
 use diffuse::DiffuseChunk;
+use rough::RoughChunk;
 use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
@@ -158,11 +165,18 @@ pub(crate) struct LaneStepper {
     /// One chunk per BSDF class: a chunk's lanes run one kernel.
     chunk: DiffuseChunk,
     smooth: SmoothChunk,
+    rough: RoughChunk,
 }
 
 impl LaneStepper {
     pub fn new(isa: LaneIsa) -> LaneStepper {
-        LaneStepper { isa, lanes: isa.lanes(), chunk: DiffuseChunk::default(), smooth: SmoothChunk::default() }
+        LaneStepper {
+            isa,
+            lanes: isa.lanes(),
+            chunk: DiffuseChunk::default(),
+            smooth: SmoothChunk::default(),
+            rough: RoughChunk::default(),
+        }
     }
 
     /// Path `i`'s step at `hit`; its results may wait until the chunk runs (at the latest at
@@ -208,6 +222,14 @@ impl LaneStepper {
             }
             return;
         }
+        if let (Bsdf::RoughConductor(m), None) = (&bsdf.bsdf, &bsdf.tilt) {
+            let light = self.light_sample(s, scene, si.p, rng);
+            self.rough.push(i as u32, path, &si, &frame, m, light, rng);
+            if self.rough.is_full(self.lanes) {
+                self.flush_rough(s, paths, samples, c);
+            }
+            return;
+        }
         let Some(reflectance) = plain_diffuse(&bsdf) else {
             path.scatter(s, scene, &si, &bsdf, &frame, rng, c, &mut Unobserved);
             return;
@@ -233,6 +255,25 @@ impl LaneStepper {
     pub fn flush(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample], c: &mut Counters) {
         self.flush_diffuse(s, paths, samples, c);
         self.flush_smooth(s, paths, samples);
+        self.flush_rough(s, paths, samples, c);
+    }
+
+    fn flush_rough(
+        &mut self,
+        s: &PathSettings,
+        paths: &mut [PathState],
+        samples: &mut [CameraSample],
+        c: &mut Counters,
+    ) {
+        if self.rough.len == 0 {
+            return;
+        }
+        self.rough.run(self.isa, s.strategy);
+        for lane in 0..self.rough.len {
+            let i = self.rough.path[lane] as usize;
+            self.rough.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
+        }
+        self.rough.len = 0;
     }
 
     fn flush_smooth(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample]) {
