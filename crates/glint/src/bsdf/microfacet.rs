@@ -120,7 +120,7 @@ impl Microfacet {
     /// `v` (upper hemisphere). For GGX it is `g1`; for Beckmann `g1` is the rational fit
     /// Mitsuba shades with (within 0.35%), and the density of the sampled normals needs the
     /// exact Λ(a) = (erf(a) - 1) / 2 + exp(-a²) / (2a√π), a = 1 / (α tan θ).
-    fn visible_fraction(&self, v: Vec3) -> f32 {
+    pub(crate) fn visible_fraction(&self, v: Vec3) -> f32 {
         let a2t2 = self.projected_alpha2_tan2(v);
         if a2t2 == 0.0 {
             return 1.0;

@@ -14,20 +14,27 @@
 //! **Bit identity.** Each lane computes exactly what `PathState::scatter` computes for its
 //! path: the same IEEE operations in the same order (Rust never contracts to FMA), the
 //! `Lanes` min/max only where the scalar code's `f32::max`/`min` give the same answer (noted
-//! at each use), and no libm calls (the concentric disk's sine and cosine are polynomials in
-//! both). `tests` below compares each lane with the one-path code on random and special
-//! inputs; `tests/wavefront.rs` renders every test scene under every schedule and compares the
-//! bits.
+//! at each use), and no libm in vector form: the concentric disk's sine and cosine are
+//! polynomials in both, and where the scalar code calls libm (`f32::cos`, `f32::exp`, f64's
+//! error function) the lanes make the same scalar call for each lane. `tests` below compares
+//! each lane with the one-path code on random and special inputs; `tests/wavefront.rs`
+//! renders every test scene under every schedule and compares the bits.
 //!
 //! Covered so far, without normal or bump maps: the Lambertian BSDF (`diffuse`: the BSDF of
 //! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), the smooth
-//! conductor and dielectric (`smooth`), and the principled BSDF with all its lobes
-//! (`principled`). Every other BSDF steps through `PathState::scatter`, one path at a time.
+//! conductor and dielectric (`smooth`), the rough conductor (`rough`: GGX and Beckmann,
+//! isotropic or anisotropic, over the lanes' microfacet distribution in `microfacet`, which
+//! makes the scalar calls of libm's sine, cosine and exponential and of Beckmann's f64 visible
+//! fraction and visible-normal sampling per lane: the same calls, so the same bits), and the
+//! principled BSDF with all its lobes (`principled`). Every other BSDF steps through
+//! `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
 mod lane_math;
+mod microfacet;
 mod principled;
+mod rough;
 mod smooth;
 
 use super::estimators::sample_light;
@@ -47,6 +54,7 @@ use crate::sampling::Sampler;
 use crate::world::{barycentric_point, Hit, ShapeRef, World};
 use diffuse::DiffuseChunk;
 use principled::PrincipledChunk;
+use rough::RoughChunk;
 use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
@@ -161,6 +169,7 @@ pub(crate) struct LaneStepper {
     chunk: DiffuseChunk,
     smooth: SmoothChunk,
     principled: PrincipledChunk,
+    rough: RoughChunk,
 }
 
 impl LaneStepper {
@@ -171,6 +180,7 @@ impl LaneStepper {
             chunk: DiffuseChunk::default(),
             smooth: SmoothChunk::default(),
             principled: PrincipledChunk::default(),
+            rough: RoughChunk::default(),
         }
     }
 
@@ -225,6 +235,14 @@ impl LaneStepper {
             }
             return;
         }
+        if let (Bsdf::RoughConductor(m), None) = (&bsdf.bsdf, &bsdf.tilt) {
+            let light = self.light_sample(s, scene, si.p, rng);
+            self.rough.push(i as u32, path, &si, &frame, m, light, rng);
+            if self.rough.is_full(self.lanes) {
+                self.flush_rough(s, paths, samples, c);
+            }
+            return;
+        }
         let Some(reflectance) = plain_diffuse(&bsdf) else {
             path.scatter(s, scene, &si, &bsdf, &frame, rng, c, &mut Unobserved);
             return;
@@ -251,6 +269,7 @@ impl LaneStepper {
         self.flush_diffuse(s, paths, samples, c);
         self.flush_smooth(s, paths, samples);
         self.flush_principled(s, paths, samples, c);
+        self.flush_rough(s, paths, samples, c);
     }
 
     fn flush_principled(
@@ -269,6 +288,24 @@ impl LaneStepper {
             self.principled.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
         }
         self.principled.len = 0;
+    }
+
+    fn flush_rough(
+        &mut self,
+        s: &PathSettings,
+        paths: &mut [PathState],
+        samples: &mut [CameraSample],
+        c: &mut Counters,
+    ) {
+        if self.rough.len == 0 {
+            return;
+        }
+        self.rough.run(self.isa, s.strategy);
+        for lane in 0..self.rough.len {
+            let i = self.rough.path[lane] as usize;
+            self.rough.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
+        }
+        self.rough.len = 0;
     }
 
     fn flush_smooth(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample]) {

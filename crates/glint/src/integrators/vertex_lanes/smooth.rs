@@ -212,9 +212,9 @@ pub(super) fn fresnel_dielectric<L: Lanes>(l: L, cos_i: L::F, eta: L::F) -> Fres
     }
 }
 
-/// `bsdf::fresnel_conductor` for one channel, in its operations.
+/// `bsdf::fresnel_conductor` for one channel, in its operations (the rough conductor's too).
 #[inline(always)]
-fn fresnel_conductor<L: Lanes>(l: L, cos_i: L::F, eta: L::F, k: L::F) -> L::F {
+pub(super) fn fresnel_conductor<L: Lanes>(l: L, cos_i: L::F, eta: L::F, k: L::F) -> L::F {
     let (zero, one, half) = (l.splat(0.0), l.splat(1.0), l.splat(0.5));
     // `cos_i.clamp(0.0, 1.0)`: NaN stays NaN (`Lanes::max`/`min` would make it a bound).
     let c = l.select(l.lt(cos_i, zero), zero, l.select(l.gt(cos_i, one), one, cos_i));

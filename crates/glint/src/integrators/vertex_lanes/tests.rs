@@ -7,11 +7,17 @@
 //! and the film discards a sample that is not finite.
 
 use super::diffuse::DiffuseChunk;
+use super::lane_math::{load3, store3};
+use super::microfacet::MicrofacetColumns;
 use super::principled::PrincipledChunk;
+use super::rough::RoughChunk;
 use super::smooth::{Smooth, SmoothChunk};
 use super::*;
+use crate::bsdf::{Microfacet, MicrofacetKind};
 use crate::integrators::{shadow_ray, spawn_ray};
-use crate::materials::{Bsdf, Conductor, Dielectric, Diffuse, Principled, PrincipledInputs, PrincipledRates};
+use crate::materials::{
+    Bsdf, Conductor, Dielectric, Diffuse, Principled, PrincipledInputs, PrincipledRates, RoughConductor,
+};
 use crate::math::{Frame, Ray};
 use crate::sampling::{power_heuristic, Rng};
 use crate::world::SurfaceInteraction;
@@ -73,22 +79,28 @@ fn surface(v: &Vertex) -> SurfaceInteraction {
     }
 }
 
+/// The shadow ray `PathState::scatter` leaves at the vertex for a BSDF that is not delta.
+fn reference_shadow(v: &Vertex, bsdf: &Bsdf, light_only: bool) -> Option<ShadowBits> {
+    let si = surface(v);
+    let wo = v.frame.to_local(-v.dir);
+    let ls = v.light?;
+    let wi = v.frame.to_local(ls.wi);
+    let f = bsdf.eval(wo, wi);
+    if f.is_black() {
+        return None;
+    }
+    let light_pdf = v.pick_pmf * ls.pdf;
+    let mis = if ls.delta || light_only { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
+    let r = shadow_ray(&si, ls.wi, ls.dist);
+    let c = v.throughput * f * ls.radiance;
+    Some((bits(r.origin), bits(r.dir), bits1(r.t_max), bits(vec3(c.r, c.g, c.b)), bits1(mis)))
+}
+
 fn reference(v: &Vertex, light_only: bool) -> Outcome {
     let si = surface(v);
     let bsdf = Bsdf::Diffuse(Diffuse { reflectance: v.reflectance });
     let wo = v.frame.to_local(-v.dir);
-    let mut shadow = None;
-    if let Some(ls) = v.light {
-        let wi = v.frame.to_local(ls.wi);
-        let f = bsdf.eval(wo, wi);
-        if !f.is_black() {
-            let light_pdf = v.pick_pmf * ls.pdf;
-            let mis = if ls.delta || light_only { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
-            let r = shadow_ray(&si, ls.wi, ls.dist);
-            let c = v.throughput * f * ls.radiance;
-            shadow = Some((bits(r.origin), bits(r.dir), bits1(r.t_max), bits(vec3(c.r, c.g, c.b)), bits1(mis)));
-        }
-    }
+    let shadow = reference_shadow(v, &bsdf, light_only);
     let next = bsdf.sample(wo, 0.5, v.u).filter(|bs| !bs.weight.is_black()).map(|bs| {
         let r = spawn_ray(&si, v.frame.to_world(bs.wi));
         (bits(r.origin), bits(r.dir), bits1(bs.pdf))
@@ -438,6 +450,197 @@ fn every_lane_finds_the_dielectric_fresnel_term_of_the_one_path_code() {
     }
 }
 
+/// Roughness for the microfacet tests: sane values mostly, the clamp's bound, tiny and huge
+/// ones, infinity, NaN and zero now and then (unclamped where the distribution is built
+/// directly).
+fn alpha(rng: &mut Rng) -> f32 {
+    const SPECIAL: [f32; 12] = [1e-4, 1e-3, 0.01, 0.1, 0.2, 0.5, 1.0, 3.0, 1e3, f32::INFINITY, f32::NAN, 0.0];
+    if rng.next_u32().is_multiple_of(3) {
+        SPECIAL[(rng.next_u32() % SPECIAL.len() as u32) as usize]
+    } else {
+        0.01 + rng.next_f32()
+    }
+}
+
+/// A GGX or Beckmann distribution, isotropic half the time; built by `Microfacet::anisotropic`
+/// (as materials build it) but one time in 16, where the roughness goes in unclamped.
+fn microfacet(rng: &mut Rng) -> Microfacet {
+    let kind = if rng.next_u32().is_multiple_of(2) { MicrofacetKind::Ggx } else { MicrofacetKind::Beckmann };
+    let alpha_u = alpha(rng);
+    let alpha_v = if rng.next_u32().is_multiple_of(2) { alpha_u } else { alpha(rng) };
+    if rng.next_u32().is_multiple_of(16) {
+        Microfacet { kind, alpha_u, alpha_v }
+    } else {
+        Microfacet::anisotropic(kind, alpha_u, alpha_v)
+    }
+}
+
+/// The lanes' distribution functions against `Microfacet::d`, `g1`, `g`, `pdf_wm` and
+/// `sample_wm`, on random and special directions and normals (the kernel sees them only
+/// through its results).
+fn check_microfacet<L: Lanes>(l: L) {
+    let mut rng = Rng::new(41, L::N as u64);
+    let mut cols = MicrofacetColumns::default();
+    let mut dirs = [[[0.0f32; MAX_LANES]; 3]; 3];
+    // The squares in the first two columns.
+    let mut u = [[0.0f32; MAX_LANES]; 3];
+    let mut out = [[0.0f32; MAX_LANES]; 5];
+    let mut wm = [[0.0f32; MAX_LANES]; 3];
+    for round in 0..20_000 {
+        let mut want = Vec::new();
+        for i in 0..L::N {
+            let m = microfacet(&mut rng);
+            cols.put(i, &m);
+            // Mostly upper-hemisphere normals (where D lives), directions on both sides,
+            // grazing ones now and then.
+            let mut h = unit(&mut rng, 30);
+            if !rng.next_u32().is_multiple_of(4) {
+                h.z = h.z.abs();
+            }
+            let wo = if rng.next_u32().is_multiple_of(8) {
+                vec3(1.0, 0.0, value(&mut rng, 1e-6, 10))
+            } else {
+                unit(&mut rng, 30)
+            };
+            let wi = unit(&mut rng, 30);
+            let ui = [rng.next_f32(), if rng.next_u32().is_multiple_of(10) { 0.0 } else { rng.next_f32() }];
+            for (k, v) in [h, wo, wi].iter().enumerate() {
+                put3(&mut dirs[k], i, [v.x, v.y, v.z]);
+            }
+            put3(&mut u, i, [ui[0], ui[1], 0.0]);
+            let expected = [m.d(h), m.g1(wo, h), m.g(wo, wi, h), m.pdf_wm(wo, h)].map(bits1);
+            want.push((expected, bits(m.sample_wm(wo, ui)), m));
+        }
+        let dist = cols.lanes(l, 0);
+        let [h, wo, wi] = dirs.each_ref().map(|d| load3(l, d, 0));
+        l.store(dist.d(l, h), &mut out[0]);
+        l.store(dist.g1(l, wo, h), &mut out[1]);
+        l.store(dist.g(l, wo, wi, h), &mut out[2]);
+        l.store(dist.pdf_wm(l, wo, h), &mut out[3]);
+        let all = (1u32 << L::N) - 1;
+        store3(l, dist.sample_wm(l, wo, [l.load(&u[0]), l.load(&u[1])], all), &mut wm, 0);
+        for (i, (expected, sampled, m)) in want.iter().enumerate() {
+            let got = [out[0][i], out[1][i], out[2][i], out[3][i]].map(bits1);
+            let ctx = (get3(&dirs[0], i), get3(&dirs[1], i), get3(&dirs[2], i), [u[0][i], u[1][i]]);
+            assert_eq!(&got, expected, "round {round} lane {i}: {m:?} (h, wo, wi, u) {ctx:?}");
+            assert_eq!(&bits(get3(&wm, i)), sampled, "round {round} lane {i}: {m:?} sample_wm {ctx:?}");
+        }
+    }
+}
+
+#[test]
+fn every_lane_finds_the_microfacet_terms_of_the_one_path_code() {
+    check_microfacet(One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if let Some(l) = Avx2x8::new() {
+            check_microfacet(l);
+        } else {
+            eprintln!("no AVX2 on this CPU: the eight-lane microfacet terms are not tested here");
+        }
+        if let Some(l) = Avx512x16::new() {
+            check_microfacet(l);
+        } else {
+            eprintln!("no AVX-512F on this CPU: the sixteen-lane microfacet terms are not tested here");
+        }
+    }
+}
+
+/// A rough conductor: gold-like to dielectric-like constants with special values, black
+/// specular now and then, and a distribution from `microfacet`.
+fn rough_conductor(rng: &mut Rng, black: bool) -> RoughConductor {
+    RoughConductor {
+        dist: microfacet(rng),
+        eta: Rgb::from_array([value(rng, 3.0, 30).abs(), value(rng, 3.0, 30), 1.5]),
+        k: Rgb::from_array([value(rng, 5.0, 30).abs(), 0.0, value(rng, 5.0, 30)]),
+        specular: if black { Rgb::BLACK } else { Rgb::from_array([1.0, rng.next_f32(), 0.5]) },
+    }
+}
+
+/// The rough conductor's lanes against `PathState::scatter`'s one-path code for
+/// `Bsdf::RoughConductor` (`eval`, `pdf`, `power_heuristic`, `shadow_ray`, then `sample`,
+/// `Frame::to_world` and `spawn_ray`): the shadow ray, and the next ray with its weight and
+/// density, or none.
+fn check_rough(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(43, lanes as u64);
+    let (mut shadows, mut samples, mut beckmann, mut total) = (0, 0, 0, 0);
+    type NextBits = ([u32; 3], [u32; 3], u32, [u32; 3]);
+    for round in 0..4000 {
+        let light_only = round % 5 == 0;
+        let mut chunk = RoughChunk::default();
+        let used = if round % 7 == 0 { 1 + round % lanes } else { lanes };
+        let mut want: Vec<(Option<ShadowBits>, Option<NextBits>, Vertex, RoughConductor)> = Vec::new();
+        for i in 0..used {
+            let v = vertex(&mut rng);
+            let m = rough_conductor(&mut rng, round % 13 == 0);
+            let si = surface(&v);
+            let mut sampler = Sampler::from_rng(Rng::new(3, (round * lanes + i) as u64));
+            let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
+            chunk.push(i as u32, &path, &si, &v.frame, &m, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
+            // The vertex's own throughput and square, in place of a new path's and the sampler's.
+            put3(&mut chunk.throughput, i, v.throughput.to_array());
+            chunk.u[0][i] = v.u[0];
+            chunk.u[1][i] = v.u[1];
+            let bsdf = Bsdf::RoughConductor(m);
+            let wo = v.frame.to_local(-v.dir);
+            let next = bsdf.sample(wo, 0.5, v.u).filter(|bs| !bs.weight.is_black()).map(|bs| {
+                let r = spawn_ray(&si, v.frame.to_world(bs.wi));
+                (bits(r.origin), bits(r.dir), bits1(bs.pdf), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)))
+            });
+            want.push((reference_shadow(&v, &bsdf, light_only), next, v, m));
+        }
+        chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
+        for (i, (shadow, next, v, m)) in want.iter().enumerate() {
+            let got_shadow = (chunk.ne.shadow[i] != 0.0).then(|| {
+                (
+                    bits(get3(&chunk.ne.shadow_origin, i)),
+                    bits(get3(&chunk.ne.shadow_dir, i)),
+                    bits1(chunk.ne.shadow_t_max[i]),
+                    bits(get3(&chunk.ne.contribution, i)),
+                    bits1(chunk.ne.mis_weight[i]),
+                )
+            });
+            let got_next = (chunk.sampled[i] != 0.0).then(|| {
+                (
+                    bits(get3(&chunk.next_origin, i)),
+                    bits(get3(&chunk.next_dir, i)),
+                    bits1(chunk.pdf[i]),
+                    bits(get3(&chunk.weight, i)),
+                )
+            });
+            assert_eq!(&got_shadow, shadow, "{isa:?} lane {i}, round {round}, shadow: {m:?} {v:?}");
+            assert_eq!(&got_next, next, "{isa:?} lane {i}, round {round}, next: {m:?} {v:?}");
+            total += 1;
+            shadows += shadow.is_some() as u32;
+            samples += next.is_some() as u32;
+            beckmann += (next.is_some() && m.dist.kind == MicrofacetKind::Beckmann) as u32;
+        }
+    }
+    assert!(
+        shadows > total / 10 && shadows < total && samples > total / 5 && samples < total && beckmann > total / 12,
+        "{isa:?}: {shadows} shadow rays, {samples} samples ({beckmann} Beckmann) of {total} vertices"
+    );
+}
+
+#[test]
+fn every_lane_scatters_off_rough_conductors_as_the_one_path_code_does() {
+    check_rough(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check_rough(LaneIsa::Avx2);
+        } else {
+            eprintln!("no AVX2 on this CPU: the eight-lane rough conductor kernel is not tested here");
+        }
+        if Avx512x16::new().is_some() {
+            check_rough(LaneIsa::Avx512);
+        } else {
+            eprintln!("no AVX-512F on this CPU: the sixteen-lane rough conductor kernel is not tested here");
+        }
+    }
+}
+
 /// The one-path code's whole step at `v` for a BSDF that is not delta: the shadow ray, then
 /// the sample (origin, direction, weight, density, eta) that `scatter` keeps.
 type SampleBits = ([u32; 3], [u32; 3], [u32; 3], u32, u32);
@@ -451,18 +654,7 @@ fn reference_scatter(
 ) -> (Option<ShadowBits>, Option<SampleBits>) {
     let si = surface(v);
     let wo = v.frame.to_local(-v.dir);
-    let mut shadow = None;
-    if let Some(ls) = v.light {
-        let wi = v.frame.to_local(ls.wi);
-        let f = bsdf.eval(wo, wi);
-        if !f.is_black() {
-            let light_pdf = v.pick_pmf * ls.pdf;
-            let mis = if ls.delta || light_only { 1.0 } else { power_heuristic(light_pdf, bsdf.pdf(wo, wi)) };
-            let r = shadow_ray(&si, ls.wi, ls.dist);
-            let c = v.throughput * f * ls.radiance;
-            shadow = Some((bits(r.origin), bits(r.dir), bits1(r.t_max), bits(vec3(c.r, c.g, c.b)), bits1(mis)));
-        }
-    }
+    let shadow = reference_shadow(v, bsdf, light_only);
     let next = bsdf.sample(wo, u_lobe, u).filter(|bs| !bs.weight.is_black()).map(|bs| {
         let r = spawn_ray(&si, v.frame.to_world(bs.wi));
         (bits(r.origin), bits(r.dir), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)), bits1(bs.pdf), bits1(bs.eta))

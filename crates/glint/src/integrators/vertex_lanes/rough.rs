@@ -1,0 +1,203 @@
+//! The rough conductor's vertex in lanes, as `PathState::scatter` computes it for
+//! `Bsdf::RoughConductor`: the BSDF's value and density towards the light, the MIS weight and
+//! the shadow ray, then a visible normal (`microfacet`), the reflected direction, its value
+//! and density (`BsdfSample::non_delta`'s rules) and the next ray.
+
+use super::columns::{NextEventColumns, VertexColumns};
+use super::lane_math::*;
+use super::microfacet::{LaneMicrofacet, MicrofacetColumns};
+use super::smooth::fresnel_conductor;
+use super::{get3, put3, Column, Column3, LaneIsa};
+use crate::describe::{PathSettings, Strategy};
+use crate::integrators::estimators::PrevEvent;
+use crate::integrators::path::PathState;
+use crate::integrators::Counters;
+use crate::lights::LightSample;
+use crate::materials::RoughConductor;
+#[cfg(target_arch = "x86_64")]
+use crate::math::lanes::{Avx2x8, Avx512x16};
+use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::{Frame, Ray, Rgb};
+use crate::sampling::Sampler;
+use crate::world::SurfaceInteraction;
+
+/// Up to [`MAX_LANES`] rough conductor vertices, one per lane.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct RoughChunk {
+    pub len: usize,
+    pub path: [u32; MAX_LANES],
+    pub(super) v: VertexColumns,
+    // In: the BSDF, the throughput, the light sample and the BSDF's square sample.
+    pub(super) dist: MicrofacetColumns,
+    pub(super) eta: Column3,
+    pub(super) k: Column3,
+    pub(super) specular: Column3,
+    pub(super) throughput: Column3,
+    pub(super) ne: NextEventColumns,
+    pub(super) u: [Column; 2],
+    // Out: the next ray, its weight and density (`sampled` 0 where the path ends).
+    pub(super) sampled: Column,
+    pub(super) weight: Column3,
+    pub(super) pdf: Column,
+    pub(super) next_origin: Column3,
+    pub(super) next_dir: Column3,
+}
+
+impl RoughChunk {
+    pub fn is_full(&self, lanes: usize) -> bool {
+        self.len >= lanes
+    }
+
+    /// Adds a path's vertex as the next lane with its light sample (drawn by the caller, first),
+    /// then draws the BSDF's random numbers from `rng` as `PathState::scatter` does: a lobe
+    /// number (unused by a conductor, drawn all the same) and a square.
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        si: &SurfaceInteraction,
+        frame: &Frame,
+        m: &RoughConductor,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) {
+        let i = self.len;
+        self.len += 1;
+        self.path[i] = path_index;
+        self.v.put_ray(i, path.ray.dir, si.p);
+        self.v.put_frame(i, si.ng, frame);
+        self.dist.put(i, &m.dist);
+        put3(&mut self.eta, i, m.eta.to_array());
+        put3(&mut self.k, i, m.k.to_array());
+        put3(&mut self.specular, i, m.specular.to_array());
+        put3(&mut self.throughput, i, path.throughput().to_array());
+        self.ne.put(i, light);
+        let _u_lobe = rng.next_f32();
+        let u = rng.next_2d();
+        self.u[0][i] = u[0];
+        self.u[1][i] = u[1];
+    }
+
+    /// Runs the kernel over the chunk's lanes on `isa`.
+    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
+        let light_only = strategy == Strategy::Light;
+        match isa {
+            LaneIsa::One => rough_chunk(One, self, light_only),
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
+            LaneIsa::Avx2 => unsafe { rough_chunk_avx2(self, light_only) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
+            LaneIsa::Avx512 => unsafe { rough_chunk_avx512(self, light_only) },
+        }
+    }
+
+    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
+        self.ne.finish(i, path, c);
+        if self.sampled[i] == 0.0 {
+            return;
+        }
+        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
+        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.v.p, i) };
+        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
+        path.go_on(s, weight, 1.0, prev, ray, rng);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn rough_chunk_avx2(chunk: &mut RoughChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX2.
+    rough_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+unsafe fn rough_chunk_avx512(chunk: &mut RoughChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX-512F.
+    rough_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
+}
+
+#[inline(always)]
+fn rough_chunk<L: Lanes>(l: L, c: &mut RoughChunk, light_only: bool) {
+    let mut base = 0;
+    while base < c.len {
+        // The lanes that hold vertices (the rest compute on stale columns, and need no
+        // scalar calls).
+        let live = (1u32 << (c.len - base).min(L::N)) - 1;
+        rough_lanes(l, c, base, live, light_only);
+        base += L::N;
+    }
+}
+
+/// `RoughConductor::eval` and `pdf` at (`wo`, `wi`), sharing their half vector and D.
+#[inline(always)]
+fn eval_pdf<L: Lanes>(
+    l: L,
+    dist: &LaneMicrofacet<L>,
+    eta: V3<L::F>,
+    k: V3<L::F>,
+    spec: V3<L::F>,
+    wo: V3<L::F>,
+    wi: V3<L::F>,
+) -> (V3<L::F>, L::F) {
+    let zero = l.splat(0.0);
+    let below = l.or(l.le(wo.z, zero), l.le(wi.z, zero));
+    // `(wo + wi).normalize()`.
+    let h = normalize(l, add3(l, wo, wi));
+    let d = dist.d(l, h);
+    let black = l.or(below, l.eq(d, zero));
+    let cos_ih = dot(l, wi, h);
+    let g = dist.g(l, wo, wi, h);
+    // `specular * f * (d * g / (4.0 * wo.z))`.
+    let s = l.div(l.mul(d, g), l.mul(l.splat(4.0), wo.z));
+    let f = V3 {
+        x: l.mul(l.mul(spec.x, fresnel_conductor(l, cos_ih, eta.x, k.x)), s),
+        y: l.mul(l.mul(spec.y, fresnel_conductor(l, cos_ih, eta.y, k.y)), s),
+        z: l.mul(l.mul(spec.z, fresnel_conductor(l, cos_ih, eta.z, k.z)), s),
+    };
+    let f = select3(l, black, V3 { x: zero, y: zero, z: zero }, f);
+    // `self.dist.pdf_wm(wo, h) / (4.0 * wo.dot(h))`.
+    let pdf = l.div(dist.pdf_wm_given_d(l, wo, h, d), l.mul(l.splat(4.0), dot(l, wo, h)));
+    (f, l.select(below, zero, pdf))
+}
+
+/// One vector of the chunk's lanes, from `base`: `PathState::scatter` for a rough conductor.
+#[inline(always)]
+fn rough_lanes<L: Lanes>(l: L, c: &mut RoughChunk, base: usize, live: u32, light_only: bool) {
+    let (zero, one) = (l.splat(0.0), l.splat(1.0));
+    let dist = c.dist.lanes(l, base);
+    let (eta, k, spec) = (load3(l, &c.eta, base), load3(l, &c.k, base), load3(l, &c.specular, base));
+    let wo = c.v.wo_local(l, base);
+
+    // Next-event estimation: the BSDF towards the light, then what `NextEventColumns::lanes`
+    // makes of it.
+    let thr = load3(l, &c.throughput, base);
+    let light_wi = c.v.local(l, base, load3(l, &c.ne.light_wi, base));
+    let (f, bsdf_pdf) = eval_pdf(l, &dist, eta, k, spec, wo, light_wi);
+    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+
+    // `RoughConductor::sample`: nothing where `wo` is below the surface, else a visible
+    // normal and the direction it reflects `wo` to.
+    let above = l.not(l.le(wo.z, zero));
+    let u = [l.load(&c.u[0][base..]), l.load(&c.u[1][base..])];
+    let h = dist.sample_wm(l, wo, u, live & l.bits(above));
+    // `(h * (2.0 * wo.dot(h)) - wo).normalize()`.
+    let wi = normalize(l, sub3(l, scale(l, h, l.mul(l.splat(2.0), dot(l, wo, h))), wo));
+    let (value, pdf) = eval_pdf(l, &dist, eta, k, spec, wo, wi);
+    // `BsdfSample::non_delta`: none below the surface or without density; the weight is
+    // `value / pdf`, a product by the reciprocal. Then `scatter` ends the path on a black one.
+    let kept = l.and(l.and_not(above, l.le(wi.z, zero)), l.gt(pdf, zero));
+    let weight = scale(l, value, l.div(one, pdf));
+    let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
+    let sampled = l.and_not(kept, black);
+    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
+    store3(l, weight, &mut c.weight, base);
+    l.store(pdf, &mut c.pdf[base..]);
+    // `frame.to_world(wi)`, then `spawn_ray`.
+    let wi_world = c.v.world(l, base, wi);
+    store3(l, wi_world, &mut c.next_dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next_origin, base);
+}
