@@ -20,14 +20,17 @@
 //! bits.
 //!
 //! Covered so far, without normal or bump maps: the Lambertian BSDF (`diffuse`: the BSDF of
-//! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), and the smooth
-//! conductor and dielectric (`smooth`). Every other BSDF steps through `PathState::scatter`,
-//! one path at a time.
+//! the Cornell boxes, the bunny and the dragon of `bench/compare-mitsuba`), the smooth
+//! conductor and dielectric (`smooth`), and the smooth plastic (`plastic`: its delta
+//! reflection and cosine-sampled base; the rough plastic is not in lanes yet). Every other
+//! BSDF steps through `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
 mod lane_math;
+mod plastic;
 mod smooth;
+mod warp;
 
 use super::estimators::sample_light;
 use super::observe::Unobserved;
@@ -45,6 +48,7 @@ use crate::math::{vec3, Rgb, Vec3};
 use crate::sampling::Sampler;
 use crate::world::{barycentric_point, Hit, ShapeRef, World};
 use diffuse::DiffuseChunk;
+use plastic::PlasticChunk;
 use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
@@ -158,11 +162,18 @@ pub(crate) struct LaneStepper {
     /// One chunk per BSDF class: a chunk's lanes run one kernel.
     chunk: DiffuseChunk,
     smooth: SmoothChunk,
+    plastic: PlasticChunk,
 }
 
 impl LaneStepper {
     pub fn new(isa: LaneIsa) -> LaneStepper {
-        LaneStepper { isa, lanes: isa.lanes(), chunk: DiffuseChunk::default(), smooth: SmoothChunk::default() }
+        LaneStepper {
+            isa,
+            lanes: isa.lanes(),
+            chunk: DiffuseChunk::default(),
+            smooth: SmoothChunk::default(),
+            plastic: PlasticChunk::default(),
+        }
     }
 
     /// Path `i`'s step at `hit`; its results may wait until the chunk runs (at the latest at
@@ -208,6 +219,17 @@ impl LaneStepper {
             }
             return;
         }
+        if let (Bsdf::Plastic(plastic), None) = (&bsdf.bsdf, &bsdf.tilt) {
+            // Only the smooth coating: a rough one steps through `scatter` below.
+            if plastic.dist.is_none() {
+                let light = self.light_sample(s, scene, si.p, rng);
+                self.plastic.push(i as u32, path, &si, &frame, plastic, light, rng);
+                if self.plastic.is_full(self.lanes) {
+                    self.flush_plastic(s, paths, samples, c);
+                }
+                return;
+            }
+        }
         let Some(reflectance) = plain_diffuse(&bsdf) else {
             path.scatter(s, scene, &si, &bsdf, &frame, rng, c, &mut Unobserved);
             return;
@@ -233,6 +255,25 @@ impl LaneStepper {
     pub fn flush(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample], c: &mut Counters) {
         self.flush_diffuse(s, paths, samples, c);
         self.flush_smooth(s, paths, samples);
+        self.flush_plastic(s, paths, samples, c);
+    }
+
+    fn flush_plastic(
+        &mut self,
+        s: &PathSettings,
+        paths: &mut [PathState],
+        samples: &mut [CameraSample],
+        c: &mut Counters,
+    ) {
+        if self.plastic.len == 0 {
+            return;
+        }
+        self.plastic.run(self.isa, s.strategy);
+        for lane in 0..self.plastic.len {
+            let i = self.plastic.path[lane] as usize;
+            self.plastic.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
+        }
+        self.plastic.len = 0;
     }
 
     fn flush_smooth(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample]) {
