@@ -25,17 +25,20 @@
 //! conductor and dielectric (`smooth`), the rough conductor (`rough`: GGX and Beckmann,
 //! isotropic or anisotropic, over the lanes' microfacet distribution in `microfacet`, which
 //! makes the scalar calls of libm's sine, cosine and exponential and of Beckmann's f64 visible
-//! fraction and visible-normal sampling per lane: the same calls, so the same bits), and the
-//! principled BSDF with all its lobes (`principled`). Every other BSDF steps through
-//! `PathState::scatter`, one path at a time.
+//! fraction and visible-normal sampling per lane: the same calls, so the same bits), the
+//! smooth plastic (`plastic`: its delta reflection and cosine-sampled base), and the
+//! principled BSDF with all its lobes (`principled`). Every other BSDF (the rough plastic and
+//! dielectric among them) steps through `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
 mod lane_math;
 mod microfacet;
+mod plastic;
 mod principled;
 mod rough;
 mod smooth;
+mod warp;
 
 use super::estimators::sample_light;
 use super::observe::Unobserved;
@@ -45,7 +48,7 @@ use super::{shading, Counters};
 use crate::accel::SimdPath;
 use crate::describe::{PathSettings, Strategy};
 use crate::lights::LightSample;
-use crate::materials::{Bsdf, DiffuseMaterial, MaterialKind, ShadedBsdf, Texture};
+use crate::materials::{Bsdf, DiffuseMaterial, MaterialKind, Texture};
 #[cfg(target_arch = "x86_64")]
 use crate::math::lanes::{Avx2x8, Avx512x16};
 use crate::math::lanes::{Lanes, One, MAX_LANES};
@@ -53,6 +56,7 @@ use crate::math::{vec3, Rgb, Vec3};
 use crate::sampling::Sampler;
 use crate::world::{barycentric_point, Hit, ShapeRef, World};
 use diffuse::DiffuseChunk;
+use plastic::PlasticChunk;
 use principled::PrincipledChunk;
 use rough::RoughChunk;
 use smooth::{Smooth, SmoothChunk};
@@ -159,17 +163,79 @@ impl MeshHit {
     }
 }
 
-/// Steps the paths of a wave as `PathState::step` does, the Lambertian vertices through the
-/// lanes: each path reaches its vertex alone, then either scatters alone or waits in the chunk,
-/// which runs when full and at [`LaneStepper::flush`].
+/// What the stepper asks of each class's chunk.
+trait Chunk {
+    /// The vertices waiting.
+    fn waiting(&self) -> usize;
+    /// Runs the class's kernel over the waiting vertices.
+    fn kernel(&mut self, isa: LaneIsa, strategy: Strategy);
+    /// Writes lane `lane`'s results into its path, as the end of `PathState::scatter` does.
+    fn finish_lane(
+        &self,
+        lane: usize,
+        paths: &mut [PathState],
+        samples: &mut [CameraSample],
+        s: &PathSettings,
+        c: &mut Counters,
+    );
+    /// Empties the chunk.
+    fn clear(&mut self);
+}
+
+/// The chunks have the same bookkeeping: `len`, `path`, `run` and `finish`.
+macro_rules! chunks {
+    ($($chunk:ty),+) => {$(
+        impl Chunk for $chunk {
+            fn waiting(&self) -> usize {
+                self.len
+            }
+            fn kernel(&mut self, isa: LaneIsa, strategy: Strategy) {
+                self.run(isa, strategy);
+            }
+            fn finish_lane(&self, lane: usize, paths: &mut [PathState], samples: &mut [CameraSample], s: &PathSettings, c: &mut Counters) {
+                let i = self.path[lane] as usize;
+                self.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
+            }
+            fn clear(&mut self) {
+                self.len = 0;
+            }
+        }
+    )+};
+}
+
+chunks!(DiffuseChunk, SmoothChunk, PlasticChunk, RoughChunk, PrincipledChunk);
+
+/// Runs `chunk`'s waiting vertices and finishes their steps.
+fn flush_chunk<C: Chunk>(
+    chunk: &mut C,
+    isa: LaneIsa,
+    s: &PathSettings,
+    paths: &mut [PathState],
+    samples: &mut [CameraSample],
+    c: &mut Counters,
+) {
+    if chunk.waiting() == 0 {
+        return;
+    }
+    chunk.kernel(isa, s.strategy);
+    for lane in 0..chunk.waiting() {
+        chunk.finish_lane(lane, paths, samples, s, c);
+    }
+    chunk.clear();
+}
+
+/// Steps the paths of a wave as `PathState::step` does, the vertices of the classes above
+/// through the lanes: each path reaches its vertex alone, then either scatters alone or waits
+/// in its class's chunk, which runs when full and at [`LaneStepper::flush`].
 pub(crate) struct LaneStepper {
     isa: LaneIsa,
     lanes: usize,
     /// One chunk per BSDF class: a chunk's lanes run one kernel.
-    chunk: DiffuseChunk,
+    diffuse: DiffuseChunk,
     smooth: SmoothChunk,
-    principled: PrincipledChunk,
+    plastic: PlasticChunk,
     rough: RoughChunk,
+    principled: PrincipledChunk,
 }
 
 impl LaneStepper {
@@ -177,10 +243,11 @@ impl LaneStepper {
         LaneStepper {
             isa,
             lanes: isa.lanes(),
-            chunk: DiffuseChunk::default(),
+            diffuse: DiffuseChunk::default(),
             smooth: SmoothChunk::default(),
-            principled: PrincipledChunk::default(),
+            plastic: PlasticChunk::default(),
             rough: RoughChunk::default(),
+            principled: PrincipledChunk::default(),
         }
     }
 
@@ -198,154 +265,134 @@ impl LaneStepper {
         hit: Option<Hit>,
         c: &mut Counters,
     ) {
+        let (isa, lanes) = (self.isa, self.lanes);
         let path = &mut paths[i];
         let rng = &mut samples[i].sampler;
+        let index = i as u32;
         if let Some((mesh_hit, p)) = hit.as_ref().and_then(|h| MeshHit::of(scene, h)) {
             // What `arrive` does at a surface that neither emits nor may be passed.
             if !path.arrive_opaque() {
                 return;
             }
-            let light = self.light_sample(s, scene, p, rng);
-            self.chunk.push_mesh(i as u32, path, &mesh_hit, p, light, rng);
-            if self.chunk.is_full(self.lanes) {
-                self.flush_diffuse(s, paths, samples, c);
+            let light = light_sample(s, scene, p, rng);
+            self.diffuse.push_mesh(index, path, &mesh_hit, p, light, rng);
+            if self.diffuse.len >= lanes {
+                flush_chunk(&mut self.diffuse, isa, s, paths, samples, c);
             }
             return;
         }
         let Some(si) = path.arrive(s, scene, hit, rng, &mut Unobserved) else { return };
         let (bsdf, frame) = shading(scene, &si, -path.ray.dir);
-        let smooth = match (&bsdf.bsdf, &bsdf.tilt) {
-            (Bsdf::Conductor(m), None) => Some(Smooth::Conductor(*m)),
-            (Bsdf::Dielectric(d), None) => Some(Smooth::Dielectric(*d)),
-            _ => None,
-        };
-        if let Some(smooth) = smooth {
-            // A delta BSDF: no light sample (`scatter` draws none either).
-            self.smooth.push(i as u32, path, &si, &frame, smooth, rng);
-            if self.smooth.is_full(self.lanes) {
-                self.flush_smooth(s, paths, samples);
-            }
-            return;
-        }
-        if let (Bsdf::Principled(b), None) = (&bsdf.bsdf, &bsdf.tilt) {
-            let light = self.light_sample(s, scene, si.p, rng);
-            self.principled.push(i as u32, path, &si, &frame, b, light, rng);
-            if self.principled.is_full(self.lanes) {
-                self.flush_principled(s, paths, samples, c);
-            }
-            return;
-        }
-        if let (Bsdf::RoughConductor(m), None) = (&bsdf.bsdf, &bsdf.tilt) {
-            let light = self.light_sample(s, scene, si.p, rng);
-            self.rough.push(i as u32, path, &si, &frame, m, light, rng);
-            if self.rough.is_full(self.lanes) {
-                self.flush_rough(s, paths, samples, c);
-            }
-            return;
-        }
-        let Some(reflectance) = plain_diffuse(&bsdf) else {
+        // A normal or bump map (`tilt`) leaves the vertex to `scatter`.
+        if bsdf.tilt.is_some() {
             path.scatter(s, scene, &si, &bsdf, &frame, rng, c, &mut Unobserved);
             return;
+        }
+        // Each class's vertex waits in its chunk with its light sample (delta BSDFs draw none,
+        // as in `scatter`) and its BSDF's random numbers. Every BSDF is named, so that a new
+        // one is placed here on purpose.
+        let (class, waiting) = match &bsdf.bsdf {
+            Bsdf::Diffuse(d) => {
+                let light = light_sample(s, scene, si.p, rng);
+                self.diffuse.push(index, path, &si, &frame, d.reflectance, light, rng);
+                (Class::Diffuse, self.diffuse.len)
+            }
+            Bsdf::Conductor(m) => {
+                self.smooth.push(index, path, &si, &frame, Smooth::Conductor(*m), rng);
+                (Class::Smooth, self.smooth.len)
+            }
+            Bsdf::Dielectric(d) => {
+                self.smooth.push(index, path, &si, &frame, Smooth::Dielectric(*d), rng);
+                (Class::Smooth, self.smooth.len)
+            }
+            Bsdf::Plastic(p) if p.dist.is_none() => {
+                let light = light_sample(s, scene, si.p, rng);
+                self.plastic.push(index, path, &si, &frame, p, light, rng);
+                (Class::Plastic, self.plastic.len)
+            }
+            Bsdf::RoughConductor(m) => {
+                let light = light_sample(s, scene, si.p, rng);
+                self.rough.push(index, path, &si, &frame, m, light, rng);
+                (Class::Rough, self.rough.len)
+            }
+            Bsdf::Principled(b) => {
+                let light = light_sample(s, scene, si.p, rng);
+                self.principled.push(index, path, &si, &frame, b, light, rng);
+                (Class::Principled, self.principled.len)
+            }
+            // Not in lanes yet: the rough plastic among them.
+            Bsdf::Plastic(_)
+            | Bsdf::Phong(_)
+            | Bsdf::RoughDielectric(_)
+            | Bsdf::ThinDielectric(_)
+            | Bsdf::Black(_)
+            | Bsdf::Null(_)
+            | Bsdf::PrincipledThin(_)
+            | Bsdf::Blend(_)
+            | Bsdf::PPlastic(_)
+            | Bsdf::Hair(_)
+            | Bsdf::GltfPbr(_)
+            | Bsdf::CoatedDiffuse(_) => {
+                path.scatter(s, scene, &si, &bsdf, &frame, rng, c, &mut Unobserved);
+                return;
+            }
         };
-        let light = self.light_sample(s, scene, si.p, rng);
-        self.chunk.push(i as u32, path, &si, &frame, reflectance, light, rng);
-        if self.chunk.is_full(self.lanes) {
-            self.flush_diffuse(s, paths, samples, c);
+        if waiting >= lanes {
+            self.flush_class(class, s, paths, samples, c);
         }
     }
 
-    /// Next-event estimation's light sample at `p` and the light's probability, as
-    /// `PathState::scatter` draws it for a BSDF that is not delta.
-    #[inline]
-    fn light_sample(&self, s: &PathSettings, scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
-        if s.strategy == Strategy::Bsdf {
-            return None;
+    /// Runs the chunk of one class.
+    fn flush_class(
+        &mut self,
+        class: Class,
+        s: &PathSettings,
+        paths: &mut [PathState],
+        samples: &mut [CameraSample],
+        c: &mut Counters,
+    ) {
+        let isa = self.isa;
+        match class {
+            Class::Diffuse => flush_chunk(&mut self.diffuse, isa, s, paths, samples, c),
+            Class::Smooth => flush_chunk(&mut self.smooth, isa, s, paths, samples, c),
+            Class::Plastic => flush_chunk(&mut self.plastic, isa, s, paths, samples, c),
+            Class::Rough => flush_chunk(&mut self.rough, isa, s, paths, samples, c),
+            Class::Principled => flush_chunk(&mut self.principled, isa, s, paths, samples, c),
         }
-        sample_light(scene, p, rng).map(|(ls, pick_pmf, _)| (ls, pick_pmf))
     }
 
     /// Runs the waiting vertices of every class and finishes their steps.
     pub fn flush(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample], c: &mut Counters) {
-        self.flush_diffuse(s, paths, samples, c);
-        self.flush_smooth(s, paths, samples);
-        self.flush_principled(s, paths, samples, c);
-        self.flush_rough(s, paths, samples, c);
-    }
-
-    fn flush_principled(
-        &mut self,
-        s: &PathSettings,
-        paths: &mut [PathState],
-        samples: &mut [CameraSample],
-        c: &mut Counters,
-    ) {
-        if self.principled.len == 0 {
-            return;
-        }
-        self.principled.run(self.isa, s.strategy);
-        for lane in 0..self.principled.len {
-            let i = self.principled.path[lane] as usize;
-            self.principled.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
-        }
-        self.principled.len = 0;
-    }
-
-    fn flush_rough(
-        &mut self,
-        s: &PathSettings,
-        paths: &mut [PathState],
-        samples: &mut [CameraSample],
-        c: &mut Counters,
-    ) {
-        if self.rough.len == 0 {
-            return;
-        }
-        self.rough.run(self.isa, s.strategy);
-        for lane in 0..self.rough.len {
-            let i = self.rough.path[lane] as usize;
-            self.rough.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
-        }
-        self.rough.len = 0;
-    }
-
-    fn flush_smooth(&mut self, s: &PathSettings, paths: &mut [PathState], samples: &mut [CameraSample]) {
-        if self.smooth.len == 0 {
-            return;
-        }
-        self.smooth.run(self.isa);
-        for lane in 0..self.smooth.len {
-            let i = self.smooth.path[lane] as usize;
-            self.smooth.finish(lane, &mut paths[i], s, &mut samples[i].sampler);
-        }
-        self.smooth.len = 0;
-    }
-
-    fn flush_diffuse(
-        &mut self,
-        s: &PathSettings,
-        paths: &mut [PathState],
-        samples: &mut [CameraSample],
-        c: &mut Counters,
-    ) {
-        if self.chunk.len == 0 {
-            return;
-        }
-        self.chunk.run(self.isa, s.strategy);
-        for lane in 0..self.chunk.len {
-            let i = self.chunk.path[lane] as usize;
-            self.chunk.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
-        }
-        self.chunk.len = 0;
+        let isa = self.isa;
+        flush_chunk(&mut self.diffuse, isa, s, paths, samples, c);
+        flush_chunk(&mut self.smooth, isa, s, paths, samples, c);
+        flush_chunk(&mut self.plastic, isa, s, paths, samples, c);
+        flush_chunk(&mut self.rough, isa, s, paths, samples, c);
+        flush_chunk(&mut self.principled, isa, s, paths, samples, c);
     }
 }
 
-/// The reflectance of a Lambertian BSDF with no normal or bump map: what the lanes cover.
+/// Next-event estimation's light sample at `p` and the light's probability, as
+/// `PathState::scatter` draws it for a BSDF that is not delta.
 #[inline]
-fn plain_diffuse(bsdf: &ShadedBsdf) -> Option<Rgb> {
-    match (&bsdf.bsdf, &bsdf.tilt) {
-        (Bsdf::Diffuse(d), None) => Some(d.reflectance),
-        _ => None,
+fn light_sample(s: &PathSettings, scene: &World, p: Vec3, rng: &mut Sampler) -> Option<(LightSample, f32)> {
+    if s.strategy == Strategy::Bsdf {
+        return None;
     }
+    sample_light(scene, p, rng).map(|(ls, pick_pmf, _)| (ls, pick_pmf))
+}
+
+/// The BSDF classes the lanes cover, one chunk each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Class {
+    Diffuse,
+    /// The smooth conductor and dielectric.
+    Smooth,
+    /// The smooth plastic.
+    Plastic,
+    /// The rough conductor.
+    Rough,
+    Principled,
 }
 
 #[cfg(test)]

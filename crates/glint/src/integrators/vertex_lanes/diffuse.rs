@@ -5,6 +5,7 @@
 
 use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
+use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use super::{flag, get3, put3, Column, Column3, LaneIsa, MeshHit};
 use crate::describe::{PathSettings, Strategy};
 use crate::integrators::estimators::PrevEvent;
@@ -14,7 +15,7 @@ use crate::lights::LightSample;
 #[cfg(target_arch = "x86_64")]
 use crate::math::lanes::{Avx2x8, Avx512x16};
 use crate::math::lanes::{Lanes, One, MAX_LANES};
-use crate::math::{Frame, Ray, Rgb, Vec3, INV_PI, PI};
+use crate::math::{Frame, Ray, Rgb, Vec3, INV_PI};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
 
@@ -52,10 +53,6 @@ pub(crate) struct DiffuseChunk {
 }
 
 impl DiffuseChunk {
-    pub fn is_full(&self, lanes: usize) -> bool {
-        self.len >= lanes
-    }
-
     /// Adds a path's vertex as the next lane, its interaction and frame computed by the scalar
     /// code, drawing its random numbers from `rng` as `PathState::scatter` does (see
     /// [`DiffuseChunk::push_common`]).
@@ -211,32 +208,21 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, light_only: 
         y: l.select(black, zero, l.mul(refl.y, k)),
         z: l.select(black, zero, l.mul(refl.z, k)),
     };
-    // `cosine_hemisphere_pdf(wi.z)`: `wi.z.max(0.0)`, where `Lanes::max` agrees (0 on NaN).
-    let bsdf_pdf = l.select(black, zero, l.mul(l.max(wi_z, zero), inv_pi));
+    // `cosine_hemisphere_pdf(wi.z)`, where `wi.z` is above 0 or NaN.
+    let bsdf_pdf = l.select(black, zero, cosine_hemisphere_pdf(l, wi_z));
     c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
 
-    // `Diffuse::sample`: `cosine_hemisphere(u)` by `concentric_disk`, in its operations.
+    // `Diffuse::sample`: `cosine_hemisphere(u)`.
     let u0 = l.load(&c.u[0][base..]);
     let u1 = l.load(&c.u[1][base..]);
-    let two = l.splat(2.0);
-    let qa = l.sub(l.mul(two, u0), one);
-    let qb = l.sub(l.mul(two, u1), one);
-    let around_y = l.le(l.abs(qa), l.abs(qb));
-    let r = l.select(around_y, qb, qa);
-    let q = l.select(around_y, qa, qb);
-    let centre = l.eq(r, zero);
-    let (sin_t, cos_t) = sin_cos_quarter(l, l.mul(l.splat(PI / 4.0), l.div(q, r)));
-    let dx = l.select(centre, zero, l.mul(r, l.select(around_y, sin_t, cos_t)));
-    let dy = l.select(centre, zero, l.mul(r, l.select(around_y, cos_t, sin_t)));
-    // `(1 - x² - y²).max(0.0)`: never -0.0 nor NaN for a sample in the square, where
-    // `Lanes::max` and `f32::max` agree.
-    let z = l.sqrt(l.max(l.sub(l.sub(one, l.mul(dx, dx)), l.mul(dy, dy)), zero));
+    let d = cosine_hemisphere(l, u0, u1);
+    let z = d.z;
     let refl_black = l.and(l.and(l.eq(refl.x, zero), l.eq(refl.y, zero)), l.eq(refl.z, zero));
     let sampled = l.and_not(l.and_not(l.not(wo_below), l.le(z, zero)), refl_black);
     l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
-    l.store(l.mul(l.max(z, zero), inv_pi), &mut c.pdf[base..]);
+    l.store(cosine_hemisphere_pdf(l, z), &mut c.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi = c.v.world(l, base, V3 { x: dx, y: dy, z });
+    let wi = c.v.world(l, base, d);
     store3(l, wi, &mut c.next_dir, base);
     store3(l, c.v.spawn_origin(l, base, wi), &mut c.next_origin, base);
 }
@@ -304,17 +290,4 @@ fn mesh_frames<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize) {
     store3(l, n, &mut v.n, base);
     store3(l, s, &mut v.s, base);
     store3(l, t, &mut v.t, base);
-}
-
-/// `warp::sin_cos_quarter`, in its operations and constants.
-#[inline(always)]
-pub(super) fn sin_cos_quarter<L: Lanes>(l: L, t: L::F) -> (L::F, L::F) {
-    let c = |x: f32| l.splat(x);
-    let t2 = l.mul(t, t);
-    let sin_poly = l.add(c(1.0 / 120.0), l.mul(t2, l.add(c(-1.0 / 5040.0), l.mul(t2, c(1.0 / 362_880.0)))));
-    let sin = l.mul(t, l.add(c(1.0), l.mul(t2, l.add(c(-1.0 / 6.0), l.mul(t2, sin_poly)))));
-    let cos_inner = l.add(c(1.0 / 40_320.0), l.mul(t2, c(-1.0 / 3_628_800.0)));
-    let cos_mid = l.add(c(1.0 / 24.0), l.mul(t2, l.add(c(-1.0 / 720.0), l.mul(t2, cos_inner))));
-    let cos = l.add(c(1.0), l.mul(t2, l.add(c(-0.5), l.mul(t2, cos_mid))));
-    (sin, cos)
 }

@@ -61,10 +61,6 @@ pub(crate) struct PrincipledChunk {
 }
 
 impl PrincipledChunk {
-    pub fn is_full(&self, lanes: usize) -> bool {
-        self.len >= lanes
-    }
-
     /// Adds a path's vertex as the next lane: its interaction and frame, the BSDF, the light
     /// sample, and the BSDF's random numbers drawn from `rng` as `PathState::scatter` draws
     /// them after the light sample (the lobe number, then the square).
@@ -207,7 +203,7 @@ fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, light_
     let p = b.probabilities(l, front, fr.reflectance);
     ok = l.and(ok, p.ok);
     // The four lobes' directions; the lobe number picks one.
-    let diffuse_wi = cosine_hemisphere(l, u0, u1);
+    let diffuse_wi = super::warp::cosine_hemisphere(l, u0, u1);
     let mc = gtr1_sample(l, b.clearcoat_alpha, u0, u1);
     let clearcoat_wi = sub3(l, scale(l, mc, l.mul(l.splat(2.0), dot(l, wo, mc))), wo);
     // `-wo / eta_ti` multiplies by the reciprocal (`Vec3`'s division); `cos_om / eta_ti` divides.
@@ -257,24 +253,6 @@ fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, light_
     let wi_world = c.v.world(l, base, wi);
     store3(l, wi_world, &mut c.next_dir, base);
     store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next_origin, base);
-}
-
-/// `warp::cosine_hemisphere(u)`.
-#[inline(always)]
-fn cosine_hemisphere<L: Lanes>(l: L, u0: L::F, u1: L::F) -> V3<L::F> {
-    let (zero, one, two) = (l.splat(0.0), l.splat(1.0), l.splat(2.0));
-    let qa = l.sub(l.mul(two, u0), one);
-    let qb = l.sub(l.mul(two, u1), one);
-    let around_y = l.le(l.abs(qa), l.abs(qb));
-    let r = l.select(around_y, qb, qa);
-    let q = l.select(around_y, qa, qb);
-    let centre = l.eq(r, zero);
-    let (sin_t, cos_t) = super::diffuse::sin_cos_quarter(l, l.mul(l.splat(PI / 4.0), l.div(q, r)));
-    let x = l.select(centre, zero, l.mul(r, l.select(around_y, sin_t, cos_t)));
-    let y = l.select(centre, zero, l.mul(r, l.select(around_y, cos_t, sin_t)));
-    // `(1 - x² - y²).max(0.0)`: never -0.0, and 0 on NaN as `f32::max` gives.
-    let z = l.sqrt(l.max(l.sub(l.sub(one, l.mul(x, x)), l.mul(y, y)), zero));
-    V3 { x, y, z }
 }
 
 /// `Gtr1::sample(u)`: the clearcoat's normal.
@@ -617,8 +595,7 @@ impl<F: Copy> Params<F> {
         let gtr1_pdf = l.select(l.lt(wh.z, zero), zero, l.mul(wh.z, gtr1_d(l, self.clearcoat_alpha, wh)));
         let cc = l.mul(l.mul(p.clearcoat, gtr1_pdf), dwh_dwi);
         pdf = l.select(l.and(reflect_ok, l.gt(p.clearcoat, zero)), l.add(pdf, cc), pdf);
-        // `cosine_hemisphere_pdf(|cos_i|)`: `Lanes::max` gives 0 on NaN, as `f32::max` does.
-        let diffuse = l.mul(p.diffuse, l.mul(l.max(l.abs(cos_i), zero), l.splat(INV_PI)));
+        let diffuse = l.mul(p.diffuse, super::warp::cosine_hemisphere_pdf(l, l.abs(cos_i)));
         pdf = l.select(l.and(reflect, l.gt(p.diffuse, zero)), l.add(pdf, diffuse), pdf);
         let trans_ok = l.and(l.and(refract, l.gt(p.spec_trans, zero)), compatible(l, wh, wo, wi, cos_o, false));
         pdf = l.select(trans_ok, l.add(pdf, l.mul(l.mul(p.spec_trans, visible), dwh_dwi)), pdf);

@@ -44,10 +44,6 @@ pub(crate) struct RoughChunk {
 }
 
 impl RoughChunk {
-    pub fn is_full(&self, lanes: usize) -> bool {
-        self.len >= lanes
-    }
-
     /// Adds a path's vertex as the next lane with its light sample (drawn by the caller, first),
     /// then draws the BSDF's random numbers from `rng` as `PathState::scatter` does: a lobe
     /// number (unused by a conductor, drawn all the same) and a square.

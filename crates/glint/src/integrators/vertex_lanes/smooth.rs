@@ -6,9 +6,10 @@
 use super::columns::VertexColumns;
 use super::lane_math::*;
 use super::{get3, put3, Column, Column3, LaneIsa};
-use crate::describe::PathSettings;
+use crate::describe::{PathSettings, Strategy};
 use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
+use crate::integrators::Counters;
 use crate::materials::{Conductor, Dielectric};
 #[cfg(target_arch = "x86_64")]
 use crate::math::lanes::{Avx2x8, Avx512x16};
@@ -49,10 +50,6 @@ pub(crate) struct SmoothChunk {
 }
 
 impl SmoothChunk {
-    pub fn is_full(&self, lanes: usize) -> bool {
-        self.len >= lanes
-    }
-
     /// Adds a path's vertex as the next lane, drawing the BSDF's random numbers from `rng` as
     /// `PathState::scatter` does (a lobe number, which the dielectric reads, and a square).
     pub fn push(
@@ -89,8 +86,9 @@ impl SmoothChunk {
         let _u = rng.next_2d();
     }
 
-    /// Runs the kernel over the chunk's lanes on `isa`.
-    pub fn run(&mut self, isa: LaneIsa) {
+    /// Runs the kernel over the chunk's lanes on `isa` (a delta BSDF has no light sample, so
+    /// the strategy does not matter).
+    pub fn run(&mut self, isa: LaneIsa, _strategy: Strategy) {
         match isa {
             LaneIsa::One => smooth_chunk(One, self),
             #[cfg(target_arch = "x86_64")]
@@ -103,7 +101,7 @@ impl SmoothChunk {
     }
 
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler) {
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, _c: &mut Counters) {
         if self.sampled[i] == 0.0 {
             return;
         }

@@ -9,6 +9,7 @@
 use super::diffuse::DiffuseChunk;
 use super::lane_math::{load3, store3};
 use super::microfacet::MicrofacetColumns;
+use super::plastic::PlasticChunk;
 use super::principled::PrincipledChunk;
 use super::rough::RoughChunk;
 use super::smooth::{Smooth, SmoothChunk};
@@ -16,7 +17,7 @@ use super::*;
 use crate::bsdf::{Microfacet, MicrofacetKind};
 use crate::integrators::{shadow_ray, spawn_ray};
 use crate::materials::{
-    Bsdf, Conductor, Dielectric, Diffuse, Principled, PrincipledInputs, PrincipledRates, RoughConductor,
+    Bsdf, Conductor, Dielectric, Diffuse, PlasticParams, Principled, PrincipledInputs, PrincipledRates, RoughConductor,
 };
 use crate::math::{Frame, Ray};
 use crate::sampling::{power_heuristic, Rng};
@@ -378,7 +379,7 @@ fn check_smooth(isa: LaneIsa) {
                 (bits(r.origin), bits(r.dir), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)), bits1(bs.eta))
             }));
         }
-        chunk.run(isa);
+        chunk.run(isa, Strategy::Mis);
         for (i, w) in want.iter().enumerate() {
             let got = (chunk.sampled[i] != 0.0).then(|| {
                 (
@@ -757,6 +758,156 @@ fn every_lane_scatters_off_the_principled_bsdf_as_the_one_path_code_does() {
         }
         if Avx512x16::new().is_some() {
             check_principled(LaneIsa::Avx512);
+        }
+    }
+}
+
+/// A smooth plastic for the plastic kernel: dielectric-like indices (index-matched, inside
+/// a denser medium, special values now and then), black bases and coats, nonlinear or not.
+fn plastic_params(rng: &mut Rng) -> PlasticParams {
+    let eta = match rng.next_u32() % 5 {
+        0 => 1.0,
+        1 => 1.0 / 1.5,
+        2 => 1.49,
+        _ => value(rng, 2.0, 30).abs(),
+    };
+    let colour = |rng: &mut Rng, black: bool| {
+        if black {
+            Rgb::BLACK
+        } else {
+            Rgb::from_array([value(rng, 1.0, 30).abs(), rng.next_f32(), rng.next_f32()])
+        }
+    };
+    let black = rng.next_u32().is_multiple_of(8);
+    let diffuse = colour(rng, black);
+    let black = rng.next_u32().is_multiple_of(8);
+    let specular = colour(rng, black);
+    let p = PlasticParams::new(diffuse, specular, eta, None);
+    PlasticParams { nonlinear: rng.next_u32().is_multiple_of(2), ..p }
+}
+
+/// What the one-path code leaves at a smooth plastic: the shadow ray, and the next ray with
+/// its density, weight and kind.
+type PlasticNext = ([u32; 3], [u32; 3], u32, [u32; 3], bool);
+
+fn plastic_reference(
+    v: &Vertex,
+    p: &PlasticParams,
+    u_lobe: f32,
+    light_only: bool,
+) -> (Option<ShadowBits>, Option<PlasticNext>) {
+    let si = surface(v);
+    let bsdf = Bsdf::Plastic(*p);
+    let wo = v.frame.to_local(-v.dir);
+    let shadow = reference_shadow(v, &bsdf, light_only);
+    let next = bsdf.sample(wo, u_lobe, v.u).filter(|bs| !bs.weight.is_black()).map(|bs| {
+        assert_eq!(bs.eta, 1.0);
+        let r = spawn_ray(&si, v.frame.to_world(bs.wi));
+        (bits(r.origin), bits(r.dir), bits1(bs.pdf), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)), bs.delta)
+    });
+    (shadow, next)
+}
+
+/// A lobe number in [0, 1): uniform, 0, or at the specular lobe's probability and either
+/// side of it (read off the delta sample the scalar code gives for lobe number 0).
+fn plastic_u_lobe(rng: &mut Rng, v: &Vertex, p: &PlasticParams) -> f32 {
+    let wo = v.frame.to_local(-v.dir);
+    let ps = Bsdf::Plastic(*p).sample(wo, 0.0, v.u).filter(|bs| bs.delta).map(|bs| bs.pdf);
+    let u = match (rng.next_u32() % 6, ps) {
+        (0, _) => 0.0,
+        (1, Some(ps)) => ps,
+        (2, Some(ps)) => f32::from_bits(ps.to_bits().saturating_sub(1)),
+        (3, Some(ps)) => f32::from_bits(ps.to_bits() + 1),
+        _ => rng.next_f32(),
+    };
+    if (0.0..1.0).contains(&u) {
+        u
+    } else {
+        rng.next_f32()
+    }
+}
+
+fn check_plastic(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(41, lanes as u64);
+    let (mut shadows, mut deltas, mut diffuse, mut none, mut total) = (0, 0, 0, 0, 0);
+    for round in 0..4000 {
+        let light_only = round % 5 == 0;
+        let mut chunk = PlasticChunk::default();
+        let used = if round % 7 == 0 { 1 + round % lanes } else { lanes };
+        let mut want = Vec::new();
+        for i in 0..used {
+            let v = vertex(&mut rng);
+            let p = plastic_params(&mut rng);
+            let u_lobe = plastic_u_lobe(&mut rng, &v, &p);
+            let si = surface(&v);
+            let mut path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
+            // The path's throughput, as `go_on` leaves it.
+            let mut sampler = Sampler::from_rng(Rng::new(3, (round * lanes + i) as u64));
+            let prev = crate::integrators::estimators::PrevEvent { pdf: 1.0, delta: true, p: Vec3::ZERO };
+            let no_roulette = PathSettings { rr_depth: u32::MAX, ..Default::default() };
+            path.go_on(&no_roulette, v.throughput, 1.0, prev, Ray::new(Vec3::ZERO, v.dir), &mut sampler);
+            chunk.push(i as u32, &path, &si, &v.frame, &p, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
+            chunk.u_lobe[i] = u_lobe;
+            chunk.u[0][i] = v.u[0];
+            chunk.u[1][i] = v.u[1];
+            want.push((v, p, plastic_reference(&v, &p, u_lobe, light_only)));
+        }
+        chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
+        for (i, (v, p, want)) in want.iter().enumerate() {
+            let shadow = (chunk.ne.shadow[i] != 0.0).then(|| {
+                (
+                    bits(get3(&chunk.ne.shadow_origin, i)),
+                    bits(get3(&chunk.ne.shadow_dir, i)),
+                    bits1(chunk.ne.shadow_t_max[i]),
+                    bits(get3(&chunk.ne.contribution, i)),
+                    bits1(chunk.ne.mis_weight[i]),
+                )
+            });
+            let next = (chunk.sampled[i] != 0.0).then(|| {
+                (
+                    bits(get3(&chunk.next_origin, i)),
+                    bits(get3(&chunk.next_dir, i)),
+                    bits1(chunk.pdf[i]),
+                    bits(get3(&chunk.weight, i)),
+                    chunk.delta[i] != 0.0,
+                )
+            });
+            assert_eq!(
+                &(shadow, next),
+                want,
+                "{isa:?} lane {i}, round {round}: {v:?} {p:?} u_lobe {}",
+                chunk.u_lobe[i]
+            );
+            total += 1;
+            shadows += want.0.is_some() as u32;
+            match want.1 {
+                Some((.., true)) => deltas += 1,
+                Some((.., false)) => diffuse += 1,
+                None => none += 1,
+            }
+        }
+    }
+    assert!(
+        shadows > total / 10 && deltas > total / 10 && diffuse > total / 10 && none > total / 10,
+        "{isa:?}: {shadows} shadow rays, {deltas} delta samples, {diffuse} diffuse samples, {none} ends of {total}"
+    );
+}
+
+#[test]
+fn every_lane_scatters_off_smooth_plastic_as_the_one_path_code_does() {
+    check_plastic(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check_plastic(LaneIsa::Avx2);
+        } else {
+            eprintln!("no AVX2 on this CPU: the eight-lane plastic kernel is not tested here");
+        }
+        if Avx512x16::new().is_some() {
+            check_plastic(LaneIsa::Avx512);
+        } else {
+            eprintln!("no AVX-512F on this CPU: the sixteen-lane plastic kernel is not tested here");
         }
     }
 }

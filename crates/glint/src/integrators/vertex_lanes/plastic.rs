@@ -1,0 +1,251 @@
+//! The smooth plastic's vertex in lanes, as `PathState::scatter` computes it for
+//! `Bsdf::Plastic` with a smooth coating (`dist` None): the diffuse lobe towards the light
+//! (the delta lobe has no value there), the MIS weight and the shadow ray, then the lobe
+//! chosen by the lobe number: the coating's mirror reflection (a delta sample) or the
+//! cosine-sampled diffuse base, and the next ray.
+//!
+//! What both coatings share (the lobe probability, the transmittance through the coating, the
+//! base's albedo and its diffuse term) is [`Coating`]; a rough coating would add its
+//! microfacet lobe to the value and density towards the light and its own reflection sample,
+//! and replace the transmittance `1 - F` by its table.
+
+use super::columns::{NextEventColumns, VertexColumns};
+use super::lane_math::*;
+use super::smooth::fresnel_dielectric;
+use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
+use super::{flag, get3, put3, Column, Column3, LaneIsa};
+use crate::describe::{PathSettings, Strategy};
+use crate::integrators::estimators::PrevEvent;
+use crate::integrators::path::PathState;
+use crate::integrators::Counters;
+use crate::lights::LightSample;
+use crate::materials::PlasticParams;
+#[cfg(target_arch = "x86_64")]
+use crate::math::lanes::{Avx2x8, Avx512x16};
+use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::{Frame, Ray, Rgb, INV_PI};
+use crate::sampling::Sampler;
+use crate::world::SurfaceInteraction;
+
+/// Up to [`MAX_LANES`] vertices of smooth plastics, one per lane: what the scalar code
+/// gathered, and what the kernel leaves. Flags are 1.0 (true) or 0.0.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct PlasticChunk {
+    pub len: usize,
+    /// Which path each lane is (the caller's index).
+    pub path: [u32; MAX_LANES],
+    pub(super) v: VertexColumns,
+    pub(super) throughput: Column3,
+    // In: the BSDF (`PlasticParams`' fields).
+    pub(super) diffuse: Column3,
+    pub(super) specular: Column3,
+    pub(super) eta: Column,
+    pub(super) fdr_internal: Column,
+    pub(super) nonlinear: Column,
+    /// The light sample in, the shadow ray out.
+    pub(super) ne: NextEventColumns,
+    // In: the BSDF's lobe number and square sample.
+    pub(super) u_lobe: Column,
+    pub(super) u: [Column; 2],
+    // Out: the next ray, the sample's weight, density and kind (`sampled` 0 where the path
+    // ends, `delta` 1 where the coating's reflection was sampled).
+    pub(super) sampled: Column,
+    pub(super) delta: Column,
+    pub(super) weight: Column3,
+    pub(super) pdf: Column,
+    pub(super) next_origin: Column3,
+    pub(super) next_dir: Column3,
+}
+
+impl PlasticChunk {
+    /// Adds a path's vertex as the next lane: its smooth plastic (`dist` None), its light
+    /// sample (drawn before, as `PathState::scatter` draws it), then the lobe number and the
+    /// square drawn from `rng` in `scatter`'s order.
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        si: &SurfaceInteraction,
+        frame: &Frame,
+        bsdf: &PlasticParams,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) {
+        debug_assert!(bsdf.dist.is_none(), "rough plastics step through the scalar code");
+        let i = self.len;
+        self.len += 1;
+        self.path[i] = path_index;
+        self.v.put_ray(i, path.ray.dir, si.p);
+        self.v.put_frame(i, si.ng, frame);
+        put3(&mut self.throughput, i, path.throughput().to_array());
+        put3(&mut self.diffuse, i, bsdf.diffuse.to_array());
+        put3(&mut self.specular, i, bsdf.specular.to_array());
+        self.eta[i] = bsdf.eta;
+        self.fdr_internal[i] = bsdf.fdr_internal;
+        self.nonlinear[i] = flag(bsdf.nonlinear);
+        self.ne.put(i, light);
+        self.u_lobe[i] = rng.next_f32();
+        let u = rng.next_2d();
+        self.u[0][i] = u[0];
+        self.u[1][i] = u[1];
+    }
+
+    /// Runs the kernel over the chunk's lanes on `isa`.
+    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
+        let light_only = strategy == Strategy::Light;
+        match isa {
+            LaneIsa::One => plastic_chunk(One, self, light_only),
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
+            LaneIsa::Avx2 => unsafe { plastic_chunk_avx2(self, light_only) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
+            LaneIsa::Avx512 => unsafe { plastic_chunk_avx512(self, light_only) },
+        }
+    }
+
+    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
+        self.ne.finish(i, path, c);
+        if self.sampled[i] == 0.0 {
+            return;
+        }
+        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
+        let prev = PrevEvent { pdf: self.pdf[i], delta: self.delta[i] != 0.0, p: get3(&self.v.p, i) };
+        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
+        path.go_on(s, weight, 1.0, prev, ray, rng);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn plastic_chunk_avx2(chunk: &mut PlasticChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX2.
+    plastic_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+unsafe fn plastic_chunk_avx512(chunk: &mut PlasticChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX-512F.
+    plastic_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
+}
+
+/// Every lane of the chunk in vectors of `L::N` (the unused lanes of the last vector compute
+/// on whatever their columns hold, and nothing reads their results).
+#[inline(always)]
+fn plastic_chunk<L: Lanes>(l: L, c: &mut PlasticChunk, light_only: bool) {
+    let mut base = 0;
+    while base < c.len {
+        plastic_lanes(l, c, base, light_only);
+        base += L::N;
+    }
+}
+
+/// The coating over one vector of lanes, for the viewing direction's cosine `wo.z`: what
+/// `PlasticParams`' `prob_specular` and `diffuse_eval` compute from `wo` alone.
+struct Coating<F> {
+    eta: F,
+    /// `eta * eta`.
+    eta2: F,
+    /// `fresnel_dielectric(wo.z, eta).reflectance`.
+    fresnel_o: F,
+    /// `coating_transmittance(wo.z)`: `1 - fresnel_o` for a smooth coating.
+    to: F,
+    /// `prob_specular(wo.z)`.
+    ps: F,
+    /// The base's albedo under the internal-scattering correction (linear or nonlinear).
+    albedo: V3<F>,
+}
+
+impl<F: Copy> Coating<F> {
+    #[inline(always)]
+    fn new<L: Lanes<F = F>>(l: L, c: &PlasticChunk, base: usize, wo_z: F) -> Coating<F> {
+        let (zero, one, three) = (l.splat(0.0), l.splat(1.0), l.splat(3.0));
+        let eta = l.load(&c.eta[base..]);
+        let diffuse = load3(l, &c.diffuse, base);
+        let specular = load3(l, &c.specular, base);
+        let fresnel_o = fresnel_dielectric(l, wo_z, eta).reflectance;
+        // `specular_weight`: `Rgb::average` is `(r + g + b) / 3`.
+        let d = l.div(l.add(l.add(diffuse.x, diffuse.y), diffuse.z), three);
+        let s = l.div(l.add(l.add(specular.x, specular.y), specular.z), three);
+        let ds = l.add(d, s);
+        let sw = l.select(l.le(ds, zero), l.splat(0.5), l.div(s, ds));
+        // `prob_specular`.
+        let ps = l.mul(fresnel_o, sw);
+        let pd = l.mul(l.sub(one, fresnel_o), l.sub(one, sw));
+        let sum = l.add(ps, pd);
+        let ps = l.select(l.le(sum, zero), zero, l.div(ps, sum));
+        // `diffuse_eval`'s albedo: `d / (1 - d F_dr)` per channel, or `diffuse / (1 - F_dr)`,
+        // which `Rgb`'s division by a number computes as a product with `1 / (1 - F_dr)`.
+        let fdr = l.load(&c.fdr_internal[base..]);
+        let nonlinear = l.gt(l.load(&c.nonlinear[base..]), zero);
+        let nl = |d: F| l.div(d, l.sub(one, l.mul(d, fdr)));
+        let albedo_nl = V3 { x: nl(diffuse.x), y: nl(diffuse.y), z: nl(diffuse.z) };
+        let albedo_lin = scale(l, diffuse, l.div(one, l.sub(one, fdr)));
+        Coating {
+            eta,
+            eta2: l.mul(eta, eta),
+            fresnel_o,
+            to: l.sub(one, fresnel_o),
+            ps,
+            albedo: select3(l, nonlinear, albedo_nl, albedo_lin),
+        }
+    }
+
+    /// `diffuse_eval(wo, wi)` for the incident cosine `wi_z`:
+    /// `albedo * (INV_PI * wi.z * to * ti / (eta * eta))`, in that order.
+    #[inline(always)]
+    fn diffuse_eval<L: Lanes<F = F>>(&self, l: L, wi_z: F) -> V3<F> {
+        let ti = l.sub(l.splat(1.0), fresnel_dielectric(l, wi_z, self.eta).reflectance);
+        let k = l.div(l.mul(l.mul(l.mul(l.splat(INV_PI), wi_z), self.to), ti), self.eta2);
+        scale(l, self.albedo, k)
+    }
+}
+
+/// One vector of the chunk's lanes, from `base`: `PathState::scatter` for a smooth plastic.
+#[inline(always)]
+fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, light_only: bool) {
+    let (zero, one) = (l.splat(0.0), l.splat(1.0));
+    let wo = c.v.wo_local(l, base);
+    let n = load3(l, &c.v.n, base);
+    let thr = load3(l, &c.throughput, base);
+    let coat = Coating::new(l, c, base, wo.z);
+    // `eval`, `pdf` and `sample` give nothing below the surface (NaN goes on).
+    let wo_below = l.le(wo.z, zero);
+
+    // Next-event estimation: `eval` and `pdf` towards the light (the diffuse lobe's only),
+    // then what `NextEventColumns::lanes` makes of them. `frame.to_local(ls.wi).z`.
+    let wi_z = dot(l, load3(l, &c.ne.light_wi, base), n);
+    let black = l.or(wo_below, l.le(wi_z, zero));
+    let f = select3(l, black, V3 { x: zero, y: zero, z: zero }, coat.diffuse_eval(l, wi_z));
+    // `(1 - ps) * cosine_hemisphere_pdf(wi.z)`, where `wi.z` is above 0 or NaN.
+    let bsdf_pdf = l.select(black, zero, l.mul(l.sub(one, coat.ps), cosine_hemisphere_pdf(l, wi_z)));
+    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+
+    // `sample`: the coating's reflection where `u_lobe < ps`, weighted `specular * (F / ps)`
+    // with density `ps`; else the cosine-sampled base, weighted `diffuse_eval / pdf` with
+    // density `(1 - ps) * cosine_hemisphere_pdf(wi.z)`, none where `wi.z <= 0`.
+    let mirror = l.lt(l.load(&c.u_lobe[base..]), coat.ps);
+    let reflected = V3 { x: l.neg(wo.x), y: l.neg(wo.y), z: wo.z };
+    let w_mirror = scale(l, load3(l, &c.specular, base), l.div(coat.fresnel_o, coat.ps));
+    let d = cosine_hemisphere(l, l.load(&c.u[0][base..]), l.load(&c.u[1][base..]));
+    // `d.z` is never -0.0 (a square root of a `max` with +0).
+    let pdf_d = l.mul(l.sub(one, coat.ps), cosine_hemisphere_pdf(l, d.z));
+    let w_diffuse = scale(l, coat.diffuse_eval(l, d.z), l.div(one, pdf_d));
+    let below_base = l.and_not(l.le(d.z, zero), mirror);
+    let kept = l.and_not(l.not(wo_below), below_base);
+    let weight = select3(l, mirror, w_mirror, w_diffuse);
+    // `scatter` ends the path on a black weight too.
+    let w_black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
+    let sampled = l.and_not(kept, w_black);
+    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
+    l.store(l.select(mirror, one, zero), &mut c.delta[base..]);
+    store3(l, weight, &mut c.weight, base);
+    l.store(l.select(mirror, coat.ps, pdf_d), &mut c.pdf[base..]);
+    // `frame.to_world(wi)`, then `spawn_ray`.
+    let wi = c.v.world(l, base, select3(l, mirror, reflected, d));
+    store3(l, wi, &mut c.next_dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next_origin, base);
+}
