@@ -220,7 +220,7 @@ impl<L: Lanes> LaneMicrofacet<L> {
 /// `microfacet::ggx_visible_normal_unit(v, u)`, the azimuth's cosine and sine by the scalar
 /// calls of the lanes set in `active` (the others get 0 for both).
 #[inline(always)]
-fn ggx_visible_normal_unit<L: Lanes>(l: L, v: V3<L::F>, u: [L::F; 2], active: u32) -> V3<L::F> {
+pub(super) fn ggx_visible_normal_unit<L: Lanes>(l: L, v: V3<L::F>, u: [L::F; 2], active: u32) -> V3<L::F> {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
     let lensq = l.add(l.mul(v.x, v.x), l.mul(v.y, v.y));
     // `Vec3 { x: -v.y, y: v.x, z: 0.0 } / lensq.sqrt()`: a product by the reciprocal.

@@ -11,6 +11,7 @@
 
 use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
+use super::microfacet::{ggx_visible_normal_unit, per_lane};
 use super::{get3, put3, Column, Column3, LaneIsa};
 use crate::describe::{PathSettings, Strategy};
 use crate::integrators::estimators::PrevEvent;
@@ -152,27 +153,10 @@ fn principled_chunk<L: Lanes>(l: L, c: &mut PrincipledChunk, light_only: bool) {
     }
 }
 
-/// `f` of each lane of `x`: the scalar code's own call, lane by lane.
+/// Every lane's bit.
 #[inline(always)]
-pub(super) fn per_lane<L: Lanes>(l: L, x: L::F, f: fn(f32) -> f32) -> L::F {
-    let mut a = [0.0f32; MAX_LANES];
-    l.store(x, &mut a);
-    for v in a.iter_mut().take(L::N) {
-        *v = f(*v);
-    }
-    l.load(&a)
-}
-
-/// `f` of each lane of `x` and `y`, lane by lane.
-#[inline(always)]
-fn per_lane2<L: Lanes>(l: L, x: L::F, y: L::F, f: fn(f32, f32) -> f32) -> L::F {
-    let (mut a, mut b) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
-    l.store(x, &mut a);
-    l.store(y, &mut b);
-    for (v, w) in a.iter_mut().zip(&b).take(L::N) {
-        *v = f(*v, *w);
-    }
-    l.load(&a)
+fn all<L: Lanes>() -> u32 {
+    u32::MAX >> (32 - L::N)
 }
 
 /// One vector of the chunk's lanes, from `base`: `PathState::scatter` for `Principled`.
@@ -260,9 +244,10 @@ fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, light_
 fn gtr1_sample<L: Lanes>(l: L, alpha: L::F, u0: L::F, u1: L::F) -> V3<L::F> {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
     let phi = l.mul(l.splat(2.0 * PI), u0);
-    let (sin_phi, cos_phi) = (per_lane(l, phi, f32::sin), per_lane(l, phi, f32::cos));
     let a2 = l.mul(alpha, alpha);
-    let cos2 = l.div(l.sub(one, per_lane2(l, a2, l.sub(one, u1), f32::powf)), l.sub(one, a2));
+    let [sin_phi, cos_phi, pow] =
+        per_lane(l, all::<L>(), [phi, a2, l.sub(one, u1)], |_, [phi, a2, e]| [phi.sin(), phi.cos(), a2.powf(e)]);
+    let cos2 = l.div(l.sub(one, pow), l.sub(one, a2));
     // `.max(0.0)` of `1 - cos2` (never -0.0) and of `cos2` (-0.0 only for a2 > 1, which
     // `clearcoat_alpha` <= 0.1 rules out): `Lanes::max` agrees with `f32::max`.
     let sin_t = l.sqrt(l.max(l.sub(one, cos2), zero));
@@ -275,7 +260,10 @@ fn gtr1_d<L: Lanes>(l: L, alpha: L::F, m: V3<L::F>) -> L::F {
     let one = l.splat(1.0);
     let a2 = l.mul(alpha, alpha);
     let a2m1 = l.sub(a2, one);
-    let den = l.mul(l.mul(l.splat(PI), per_lane(l, a2, f32::ln)), l.add(one, l.mul(l.mul(a2m1, m.z), m.z)));
+    let den = l.mul(
+        l.mul(l.splat(PI), per_lane(l, all::<L>(), [a2], |_, [a2]| [a2.ln()])[0]),
+        l.add(one, l.mul(l.mul(a2m1, m.z), m.z)),
+    );
     let r = l.div(a2m1, den);
     l.select(l.gt(l.mul(r, m.z), l.splat(1e-20)), r, l.splat(0.0))
 }
@@ -457,22 +445,9 @@ impl<F: Copy> Params<F> {
     /// `AnisoGgx::sample_visible(v, u)`.
     #[inline(always)]
     fn sample_visible<L: Lanes<F = F>>(&self, l: L, v: V3<F>, u0: F, u1: F) -> V3<F> {
-        let (zero, one) = (l.splat(0.0), l.splat(1.0));
         let (ax, ay) = (self.alpha_x, self.alpha_y);
         let vh = normalize(l, V3 { x: l.mul(ax, v.x), y: l.mul(ay, v.y), z: v.z });
-        let lensq = l.add(l.mul(vh.x, vh.x), l.mul(vh.y, vh.y));
-        let t1_turned = scale(l, V3 { x: l.neg(vh.y), y: vh.x, z: zero }, l.div(one, l.sqrt(lensq)));
-        let t1 = select3(l, l.gt(lensq, zero), t1_turned, V3 { x: one, y: zero, z: zero });
-        let t2 = cross(l, vh, t1);
-        let r = l.sqrt(u0);
-        let phi = l.mul(l.splat(2.0 * PI), u1);
-        let p1 = l.mul(r, per_lane(l, phi, f32::cos));
-        let s = l.mul(l.splat(0.5), l.add(one, vh.z));
-        // `.max(0.0)` of `1 - x` (never -0.0; 0 on NaN as `f32::max` gives).
-        let rest = l.sqrt(l.max(l.sub(one, l.mul(p1, p1)), zero));
-        let p2 = l.add(l.mul(l.sub(one, s), rest), l.mul(l.mul(s, r), per_lane(l, phi, f32::sin)));
-        let up = l.sqrt(l.max(l.sub(l.sub(one, l.mul(p1, p1)), l.mul(p2, p2)), zero));
-        let nh = add3(l, add3(l, scale(l, t1, p1), scale(l, t2, p2)), scale(l, vh, up));
+        let nh = ggx_visible_normal_unit(l, vh, [u0, u1], all::<L>());
         // `nh.z.max(1e-6)`: `max_num`, since `nh.z` may be NaN.
         normalize(l, V3 { x: l.mul(ax, nh.x), y: l.mul(ay, nh.y), z: max_num(l, nh.z, l.splat(1e-6)) })
     }
