@@ -242,9 +242,15 @@ fn half_vector(eta: f32, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32, bool)> {
     Some((wm, etap, reflect))
 }
 
+/// A tint's share in the choice between reflection and transmission: its largest channel,
+/// at most 1, and at least 1e-3 unless the tint is black.
+pub(crate) fn lobe_weight(tint: Rgb) -> f32 {
+    tint.max_component().min(1.0).max(if tint.is_black() { 0.0 } else { 1e-3 })
+}
+
 fn lobe_probabilities(f: f32, reflect: Rgb, transmit: Rgb) -> (f32, f32) {
-    let pr = f * reflect.max_component().min(1.0).max(if reflect.is_black() { 0.0 } else { 1e-3 });
-    let pt = (1.0 - f) * transmit.max_component().min(1.0).max(if transmit.is_black() { 0.0 } else { 1e-3 });
+    let pr = f * lobe_weight(reflect);
+    let pt = (1.0 - f) * lobe_weight(transmit);
     let s = pr + pt;
     if s <= 0.0 {
         (0.0, 0.0)

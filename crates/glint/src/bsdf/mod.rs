@@ -21,6 +21,8 @@ mod fresnel;
 mod microfacet;
 
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, reflect_local, refract_local, DielectricFresnel};
+/// For the rough dielectric's kernel in the path tracer's vertex lanes.
+pub(crate) use microfacet::lobe_weight;
 pub use microfacet::{
     eval_rough_dielectric, pdf_rough_dielectric, sample_rough_dielectric, Microfacet, MicrofacetKind,
 };

@@ -26,9 +26,11 @@
 //! isotropic or anisotropic, over the lanes' microfacet distribution in `microfacet`, which
 //! makes the scalar calls of libm's sine, cosine and exponential and of Beckmann's f64 visible
 //! fraction and visible-normal sampling per lane: the same calls, so the same bits), the
-//! smooth plastic (`plastic`: its delta reflection and cosine-sampled base), and the
-//! principled BSDF with all its lobes (`principled`). Every other BSDF (the rough plastic and
-//! dielectric among them) steps through `PathState::scatter`, one path at a time.
+//! rough dielectric (`rough_dielectric`: reflection and refraction through the same
+//! distribution, from either side of the interface), the smooth plastic (`plastic`: its delta
+//! reflection and cosine-sampled base), and the principled BSDF with all its lobes
+//! (`principled`). Every other BSDF (the rough plastic among them) steps through
+//! `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
@@ -37,6 +39,7 @@ mod microfacet;
 mod plastic;
 mod principled;
 mod rough;
+mod rough_dielectric;
 mod smooth;
 mod warp;
 
@@ -59,6 +62,7 @@ use diffuse::DiffuseChunk;
 use plastic::PlasticChunk;
 use principled::PrincipledChunk;
 use rough::RoughChunk;
+use rough_dielectric::RoughDielectricChunk;
 use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
@@ -203,7 +207,7 @@ macro_rules! chunks {
     )+};
 }
 
-chunks!(DiffuseChunk, SmoothChunk, PlasticChunk, RoughChunk, PrincipledChunk);
+chunks!(DiffuseChunk, SmoothChunk, PlasticChunk, RoughChunk, RoughDielectricChunk, PrincipledChunk);
 
 /// Runs `chunk`'s waiting vertices and finishes their steps.
 fn flush_chunk<C: Chunk>(
@@ -235,6 +239,7 @@ pub(crate) struct LaneStepper {
     smooth: SmoothChunk,
     plastic: PlasticChunk,
     rough: RoughChunk,
+    rough_dielectric: RoughDielectricChunk,
     principled: PrincipledChunk,
 }
 
@@ -247,6 +252,7 @@ impl LaneStepper {
             smooth: SmoothChunk::default(),
             plastic: PlasticChunk::default(),
             rough: RoughChunk::default(),
+            rough_dielectric: RoughDielectricChunk::default(),
             principled: PrincipledChunk::default(),
         }
     }
@@ -315,6 +321,11 @@ impl LaneStepper {
                 self.rough.push(index, path, &si, &frame, m, light, rng);
                 (Class::Rough, self.rough.len)
             }
+            Bsdf::RoughDielectric(d) => {
+                let light = light_sample(s, scene, si.p, rng);
+                self.rough_dielectric.push(index, path, &si, &frame, d, light, rng);
+                (Class::RoughDielectric, self.rough_dielectric.len)
+            }
             Bsdf::Principled(b) => {
                 let light = light_sample(s, scene, si.p, rng);
                 self.principled.push(index, path, &si, &frame, b, light, rng);
@@ -323,7 +334,6 @@ impl LaneStepper {
             // Not in lanes yet: the rough plastic among them.
             Bsdf::Plastic(_)
             | Bsdf::Phong(_)
-            | Bsdf::RoughDielectric(_)
             | Bsdf::ThinDielectric(_)
             | Bsdf::Black(_)
             | Bsdf::Null(_)
@@ -357,6 +367,7 @@ impl LaneStepper {
             Class::Smooth => flush_chunk(&mut self.smooth, isa, s, paths, samples, c),
             Class::Plastic => flush_chunk(&mut self.plastic, isa, s, paths, samples, c),
             Class::Rough => flush_chunk(&mut self.rough, isa, s, paths, samples, c),
+            Class::RoughDielectric => flush_chunk(&mut self.rough_dielectric, isa, s, paths, samples, c),
             Class::Principled => flush_chunk(&mut self.principled, isa, s, paths, samples, c),
         }
     }
@@ -368,6 +379,7 @@ impl LaneStepper {
         flush_chunk(&mut self.smooth, isa, s, paths, samples, c);
         flush_chunk(&mut self.plastic, isa, s, paths, samples, c);
         flush_chunk(&mut self.rough, isa, s, paths, samples, c);
+        flush_chunk(&mut self.rough_dielectric, isa, s, paths, samples, c);
         flush_chunk(&mut self.principled, isa, s, paths, samples, c);
     }
 }
@@ -392,6 +404,8 @@ enum Class {
     Plastic,
     /// The rough conductor.
     Rough,
+    /// The rough dielectric.
+    RoughDielectric,
     Principled,
 }
 

@@ -12,12 +12,14 @@ use super::microfacet::MicrofacetColumns;
 use super::plastic::PlasticChunk;
 use super::principled::PrincipledChunk;
 use super::rough::RoughChunk;
+use super::rough_dielectric::RoughDielectricChunk;
 use super::smooth::{Smooth, SmoothChunk};
 use super::*;
 use crate::bsdf::{Microfacet, MicrofacetKind};
 use crate::integrators::{shadow_ray, spawn_ray};
 use crate::materials::{
     Bsdf, Conductor, Dielectric, Diffuse, PlasticParams, Principled, PrincipledInputs, PrincipledRates, RoughConductor,
+    RoughDielectric,
 };
 use crate::math::{Frame, Ray};
 use crate::sampling::{power_heuristic, Rng};
@@ -908,6 +910,143 @@ fn every_lane_scatters_off_smooth_plastic_as_the_one_path_code_does() {
             check_plastic(LaneIsa::Avx512);
         } else {
             eprintln!("no AVX-512F on this CPU: the sixteen-lane plastic kernel is not tested here");
+        }
+    }
+}
+
+/// A rough dielectric: glass-like indices from either side (index-matched, below 1, above 1,
+/// special values now and then), white, coloured, black or special tints, and a distribution
+/// from `microfacet` (GGX and Beckmann, tiny, huge, anisotropic and unclamped roughness).
+fn rough_dielectric(rng: &mut Rng) -> RoughDielectric {
+    let eta = match rng.next_u32() % 8 {
+        0 => 1.0,
+        1 => 1.0 / 1.5,
+        2 => 1.5,
+        3 => 1.0 + 1e-6,
+        4 => value(rng, 3.0, 8).abs(),
+        _ => 1.0 + 1.5 * rng.next_f32(),
+    };
+    let tint = |rng: &mut Rng| match rng.next_u32() % 10 {
+        0 => Rgb::BLACK,
+        1..=4 => Rgb::WHITE,
+        5 => Rgb::from_array([value(rng, 2.0, 4), value(rng, 1.0, 4), 0.0]),
+        _ => Rgb::from_array([rng.next_f32(), rng.next_f32(), rng.next_f32()]),
+    };
+    RoughDielectric { dist: microfacet(rng), eta, reflect: tint(rng), transmit: tint(rng) }
+}
+
+/// A lobe number in [0, 1): uniform, 0, or at the reflection's probability at the normal that
+/// `u` samples and either side of it (computed as `lobe_probabilities` computes it).
+fn rough_dielectric_u_lobe(rng: &mut Rng, v: &Vertex, b: &RoughDielectric) -> f32 {
+    let wo = v.frame.to_local(-v.dir);
+    let wm = b.dist.sample_wm(wo, v.u);
+    let f = crate::bsdf::fresnel_dielectric(wo.dot(wm), b.eta).reflectance;
+    let (pr, pt) = (f * crate::bsdf::lobe_weight(b.reflect), (1.0 - f) * crate::bsdf::lobe_weight(b.transmit));
+    let pr = pr / (pr + pt);
+    let u = match rng.next_u32() % 8 {
+        0 => 0.0,
+        1 => pr,
+        2 => f32::from_bits(pr.to_bits().saturating_sub(1)),
+        3 => f32::from_bits(pr.to_bits() + 1),
+        _ => rng.next_f32(),
+    };
+    if (0.0..1.0).contains(&u) {
+        u
+    } else {
+        rng.next_f32()
+    }
+}
+
+/// The rough dielectric's lanes against `PathState::scatter`'s one-path code for
+/// `Bsdf::RoughDielectric` (`reference_scatter`): the shadow ray, and the next ray with its
+/// weight, density and eta, or none.
+fn check_rough_dielectric(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(47, lanes as u64);
+    let (mut shadows, mut reflected, mut refracted, mut inside, mut ends, mut beckmann, mut total) =
+        (0, 0, 0, 0, 0, 0, 0);
+    for round in 0..4000 {
+        let light_only = round % 5 == 0;
+        let mut chunk = RoughDielectricChunk::default();
+        let used = if round % 7 == 0 { 1 + round % lanes } else { lanes };
+        let mut want = Vec::new();
+        for i in 0..used {
+            let v = vertex(&mut rng);
+            let b = rough_dielectric(&mut rng);
+            let u_lobe = rough_dielectric_u_lobe(&mut rng, &v, &b);
+            let si = surface(&v);
+            let mut sampler = Sampler::from_rng(Rng::new(3, (round * lanes + i) as u64));
+            let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
+            chunk.push(i as u32, &path, &si, &v.frame, &b, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
+            // The vertex's own throughput and numbers, in place of a new path's and the sampler's.
+            put3(&mut chunk.throughput, i, v.throughput.to_array());
+            chunk.u_lobe[i] = u_lobe;
+            chunk.u[0][i] = v.u[0];
+            chunk.u[1][i] = v.u[1];
+            let bsdf = Bsdf::RoughDielectric(b);
+            let wo = v.frame.to_local(-v.dir);
+            let kind = bsdf.sample(wo, u_lobe, v.u).filter(|bs| !bs.weight.is_black()).map(|bs| bs.wi.z * wo.z < 0.0);
+            want.push((reference_scatter(&v, &bsdf, u_lobe, v.u, light_only), kind, wo.z < 0.0, v, b));
+        }
+        chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
+        for (i, (w, kind, below, v, b)) in want.iter().enumerate() {
+            let c = &chunk;
+            let shadow = (c.ne.shadow[i] != 0.0).then(|| {
+                (
+                    bits(get3(&c.ne.shadow_origin, i)),
+                    bits(get3(&c.ne.shadow_dir, i)),
+                    bits1(c.ne.shadow_t_max[i]),
+                    bits(get3(&c.ne.contribution, i)),
+                    bits1(c.ne.mis_weight[i]),
+                )
+            });
+            let next = (c.sampled[i] != 0.0).then(|| {
+                (
+                    bits(get3(&c.next_origin, i)),
+                    bits(get3(&c.next_dir, i)),
+                    bits(get3(&c.weight, i)),
+                    bits1(c.pdf[i]),
+                    bits1(c.eta_out[i]),
+                )
+            });
+            assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {b:?} u_lobe {}", c.u_lobe[i]);
+            total += 1;
+            shadows += w.0.is_some() as u32;
+            match kind {
+                Some(true) => refracted += 1,
+                Some(false) => reflected += 1,
+                None => ends += 1,
+            }
+            inside += (kind.is_some() && *below) as u32;
+            beckmann += (kind.is_some() && b.dist.kind == MicrofacetKind::Beckmann) as u32;
+        }
+    }
+    assert!(
+        shadows > total / 10
+            && reflected > total / 10
+            && refracted > total / 10
+            && ends > total / 10
+            && inside > total / 10
+            && beckmann > total / 10,
+        "{isa:?}: {shadows} shadow rays, {reflected} reflected and {refracted} refracted samples ({inside} from \
+         inside, {beckmann} Beckmann), {ends} ends of {total} vertices"
+    );
+}
+
+#[test]
+fn every_lane_scatters_off_rough_dielectrics_as_the_one_path_code_does() {
+    check_rough_dielectric(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check_rough_dielectric(LaneIsa::Avx2);
+        } else {
+            eprintln!("no AVX2 on this CPU: the eight-lane rough dielectric kernel is not tested here");
+        }
+        if Avx512x16::new().is_some() {
+            check_rough_dielectric(LaneIsa::Avx512);
+        } else {
+            eprintln!("no AVX-512F on this CPU: the sixteen-lane rough dielectric kernel is not tested here");
         }
     }
 }
