@@ -26,9 +26,11 @@
 //! isotropic or anisotropic, over the lanes' microfacet distribution in `microfacet`, which
 //! makes the scalar calls of libm's sine, cosine and exponential and of Beckmann's f64 visible
 //! fraction and visible-normal sampling per lane: the same calls, so the same bits), the
-//! smooth plastic (`plastic`: its delta reflection and cosine-sampled base), and the
-//! principled BSDF with all its lobes (`principled`). Every other BSDF (the rough plastic and
-//! dielectric among them) steps through `PathState::scatter`, one path at a time.
+//! smooth plastic (`plastic`: its delta reflection and cosine-sampled base), the rough plastic
+//! (`rough_plastic`: its coating's microfacet reflection over the same distribution, and the
+//! coating's transmittance table read by the scalar function per lane), and the principled
+//! BSDF with all its lobes (`principled`). Every other BSDF (the rough dielectric among them)
+//! steps through `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
@@ -37,6 +39,7 @@ mod microfacet;
 mod plastic;
 mod principled;
 mod rough;
+mod rough_plastic;
 mod smooth;
 mod warp;
 
@@ -59,6 +62,7 @@ use diffuse::DiffuseChunk;
 use plastic::PlasticChunk;
 use principled::PrincipledChunk;
 use rough::RoughChunk;
+use rough_plastic::RoughPlasticChunk;
 use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
@@ -203,7 +207,7 @@ macro_rules! chunks {
     )+};
 }
 
-chunks!(DiffuseChunk, SmoothChunk, PlasticChunk, RoughChunk, PrincipledChunk);
+chunks!(DiffuseChunk, SmoothChunk, PlasticChunk, RoughPlasticChunk, RoughChunk, PrincipledChunk);
 
 /// Runs `chunk`'s waiting vertices and finishes their steps.
 fn flush_chunk<C: Chunk>(
@@ -234,6 +238,7 @@ pub(crate) struct LaneStepper {
     diffuse: DiffuseChunk,
     smooth: SmoothChunk,
     plastic: PlasticChunk,
+    rough_plastic: RoughPlasticChunk,
     rough: RoughChunk,
     principled: PrincipledChunk,
 }
@@ -246,6 +251,7 @@ impl LaneStepper {
             diffuse: DiffuseChunk::default(),
             smooth: SmoothChunk::default(),
             plastic: PlasticChunk::default(),
+            rough_plastic: RoughPlasticChunk::default(),
             rough: RoughChunk::default(),
             principled: PrincipledChunk::default(),
         }
@@ -305,10 +311,18 @@ impl LaneStepper {
                 self.smooth.push(index, path, &si, &frame, Smooth::Dielectric(*d), rng);
                 (Class::Smooth, self.smooth.len)
             }
-            Bsdf::Plastic(p) if p.dist.is_none() => {
+            Bsdf::Plastic(p) => {
                 let light = light_sample(s, scene, si.p, rng);
-                self.plastic.push(index, path, &si, &frame, p, light, rng);
-                (Class::Plastic, self.plastic.len)
+                match &p.dist {
+                    None => {
+                        self.plastic.push(index, path, &si, &frame, p, light, rng);
+                        (Class::Plastic, self.plastic.len)
+                    }
+                    Some(dist) => {
+                        self.rough_plastic.push(index, path, &si, &frame, p, dist, light, rng);
+                        (Class::RoughPlastic, self.rough_plastic.len)
+                    }
+                }
             }
             Bsdf::RoughConductor(m) => {
                 let light = light_sample(s, scene, si.p, rng);
@@ -320,9 +334,8 @@ impl LaneStepper {
                 self.principled.push(index, path, &si, &frame, b, light, rng);
                 (Class::Principled, self.principled.len)
             }
-            // Not in lanes yet: the rough plastic among them.
-            Bsdf::Plastic(_)
-            | Bsdf::Phong(_)
+            // Not in lanes yet.
+            Bsdf::Phong(_)
             | Bsdf::RoughDielectric(_)
             | Bsdf::ThinDielectric(_)
             | Bsdf::Black(_)
@@ -356,6 +369,7 @@ impl LaneStepper {
             Class::Diffuse => flush_chunk(&mut self.diffuse, isa, s, paths, samples, c),
             Class::Smooth => flush_chunk(&mut self.smooth, isa, s, paths, samples, c),
             Class::Plastic => flush_chunk(&mut self.plastic, isa, s, paths, samples, c),
+            Class::RoughPlastic => flush_chunk(&mut self.rough_plastic, isa, s, paths, samples, c),
             Class::Rough => flush_chunk(&mut self.rough, isa, s, paths, samples, c),
             Class::Principled => flush_chunk(&mut self.principled, isa, s, paths, samples, c),
         }
@@ -367,6 +381,7 @@ impl LaneStepper {
         flush_chunk(&mut self.diffuse, isa, s, paths, samples, c);
         flush_chunk(&mut self.smooth, isa, s, paths, samples, c);
         flush_chunk(&mut self.plastic, isa, s, paths, samples, c);
+        flush_chunk(&mut self.rough_plastic, isa, s, paths, samples, c);
         flush_chunk(&mut self.rough, isa, s, paths, samples, c);
         flush_chunk(&mut self.principled, isa, s, paths, samples, c);
     }
@@ -390,6 +405,8 @@ enum Class {
     Smooth,
     /// The smooth plastic.
     Plastic,
+    /// The rough plastic.
+    RoughPlastic,
     /// The rough conductor.
     Rough,
     Principled,
