@@ -28,9 +28,10 @@
 //! fraction and visible-normal sampling per lane: the same calls, so the same bits), the
 //! rough dielectric (`rough_dielectric`: reflection and refraction through the same
 //! distribution, from either side of the interface), the smooth plastic (`plastic`: its delta
-//! reflection and cosine-sampled base), and the principled BSDF with all its lobes
-//! (`principled`). Every other BSDF (the rough plastic among them) steps through
-//! `PathState::scatter`, one path at a time.
+//! reflection and cosine-sampled base), the rough plastic (`rough_plastic`: its coating's
+//! microfacet reflection over the same distribution, and the coating's transmittance table
+//! read by the scalar function per lane), and the principled BSDF with all its lobes
+//! (`principled`). Every other BSDF steps through `PathState::scatter`, one path at a time.
 
 mod columns;
 mod diffuse;
@@ -40,6 +41,7 @@ mod plastic;
 mod principled;
 mod rough;
 mod rough_dielectric;
+mod rough_plastic;
 mod smooth;
 mod warp;
 
@@ -63,6 +65,7 @@ use plastic::PlasticChunk;
 use principled::PrincipledChunk;
 use rough::RoughChunk;
 use rough_dielectric::RoughDielectricChunk;
+use rough_plastic::RoughPlasticChunk;
 use smooth::{Smooth, SmoothChunk};
 
 /// Which lanes run the kernels: the widest the traversal's choice (`GLINT_SIMD`) allows.
@@ -207,7 +210,7 @@ macro_rules! chunks {
     )+};
 }
 
-chunks!(DiffuseChunk, SmoothChunk, PlasticChunk, RoughChunk, RoughDielectricChunk, PrincipledChunk);
+chunks!(DiffuseChunk, SmoothChunk, PlasticChunk, RoughPlasticChunk, RoughChunk, RoughDielectricChunk, PrincipledChunk);
 
 /// Runs `chunk`'s waiting vertices and finishes their steps.
 fn flush_chunk<C: Chunk>(
@@ -238,6 +241,7 @@ pub(crate) struct LaneStepper {
     diffuse: DiffuseChunk,
     smooth: SmoothChunk,
     plastic: PlasticChunk,
+    rough_plastic: RoughPlasticChunk,
     rough: RoughChunk,
     rough_dielectric: RoughDielectricChunk,
     principled: PrincipledChunk,
@@ -251,6 +255,7 @@ impl LaneStepper {
             diffuse: DiffuseChunk::default(),
             smooth: SmoothChunk::default(),
             plastic: PlasticChunk::default(),
+            rough_plastic: RoughPlasticChunk::default(),
             rough: RoughChunk::default(),
             rough_dielectric: RoughDielectricChunk::default(),
             principled: PrincipledChunk::default(),
@@ -311,10 +316,20 @@ impl LaneStepper {
                 self.smooth.push(index, path, &si, &frame, Smooth::Dielectric(*d), rng);
                 (Class::Smooth, self.smooth.len)
             }
-            Bsdf::Plastic(p) if p.dist.is_none() => {
+            // The smooth kernel's coating transmits 1 - F: a smooth coating with a table (only
+            // a hand-built plastic has one) steps through `scatter` below.
+            Bsdf::Plastic(p) if p.dist.is_some() || p.transmittance.is_none() => {
                 let light = light_sample(s, scene, si.p, rng);
-                self.plastic.push(index, path, &si, &frame, p, light, rng);
-                (Class::Plastic, self.plastic.len)
+                match &p.dist {
+                    None => {
+                        self.plastic.push(index, path, &si, &frame, p, light, rng);
+                        (Class::Plastic, self.plastic.len)
+                    }
+                    Some(dist) => {
+                        self.rough_plastic.push(index, path, &si, &frame, p, dist, light, rng);
+                        (Class::RoughPlastic, self.rough_plastic.len)
+                    }
+                }
             }
             Bsdf::RoughConductor(m) => {
                 let light = light_sample(s, scene, si.p, rng);
@@ -331,7 +346,7 @@ impl LaneStepper {
                 self.principled.push(index, path, &si, &frame, b, light, rng);
                 (Class::Principled, self.principled.len)
             }
-            // Not in lanes yet: the rough plastic among them.
+            // Not in lanes yet.
             Bsdf::Plastic(_)
             | Bsdf::Phong(_)
             | Bsdf::ThinDielectric(_)
@@ -366,6 +381,7 @@ impl LaneStepper {
             Class::Diffuse => flush_chunk(&mut self.diffuse, isa, s, paths, samples, c),
             Class::Smooth => flush_chunk(&mut self.smooth, isa, s, paths, samples, c),
             Class::Plastic => flush_chunk(&mut self.plastic, isa, s, paths, samples, c),
+            Class::RoughPlastic => flush_chunk(&mut self.rough_plastic, isa, s, paths, samples, c),
             Class::Rough => flush_chunk(&mut self.rough, isa, s, paths, samples, c),
             Class::RoughDielectric => flush_chunk(&mut self.rough_dielectric, isa, s, paths, samples, c),
             Class::Principled => flush_chunk(&mut self.principled, isa, s, paths, samples, c),
@@ -378,6 +394,7 @@ impl LaneStepper {
         flush_chunk(&mut self.diffuse, isa, s, paths, samples, c);
         flush_chunk(&mut self.smooth, isa, s, paths, samples, c);
         flush_chunk(&mut self.plastic, isa, s, paths, samples, c);
+        flush_chunk(&mut self.rough_plastic, isa, s, paths, samples, c);
         flush_chunk(&mut self.rough, isa, s, paths, samples, c);
         flush_chunk(&mut self.rough_dielectric, isa, s, paths, samples, c);
         flush_chunk(&mut self.principled, isa, s, paths, samples, c);
@@ -402,6 +419,8 @@ enum Class {
     Smooth,
     /// The smooth plastic.
     Plastic,
+    /// The rough plastic.
+    RoughPlastic,
     /// The rough conductor.
     Rough,
     /// The rough dielectric.

@@ -117,6 +117,22 @@ fn rough_coating_tables(d: &Microfacet, eta: f32) -> (f32, &'static [f32; TRANSM
     *cache.lock().unwrap_or_else(|e| e.into_inner()).entry(key).or_insert(entry)
 }
 
+/// Energy transmitted through a coating of index `eta` for direction cosine `cos`: `1 - F`
+/// without a table (a smooth coating), else the table interpolated linearly. A free function
+/// so that the vertex lanes call this very code per lane (the table is a gather).
+#[inline]
+pub(crate) fn coating_transmittance(table: Option<&[f32; TRANSMITTANCE_RES]>, eta: f32, cos: f32) -> f32 {
+    match table {
+        None => 1.0 - fresnel_dielectric(cos, eta).reflectance,
+        Some(t) => {
+            let x = cos.clamp(0.0, 1.0) * (TRANSMITTANCE_RES - 1) as f32;
+            let i = (x as usize).min(TRANSMITTANCE_RES - 2);
+            let f = x - i as f32;
+            t[i] * (1.0 - f) + t[i + 1] * f
+        }
+    }
+}
+
 impl PlasticParams {
     pub fn new(diffuse: Rgb, specular: Rgb, eta: f32, dist: Option<Microfacet>) -> PlasticParams {
         let (fdr_internal, transmittance) = match &dist {
@@ -131,15 +147,7 @@ impl PlasticParams {
 
     /// Energy transmitted through the coating for direction cosine `cos`.
     fn coating_transmittance(&self, cos: f32) -> f32 {
-        match &self.transmittance {
-            None => 1.0 - fresnel_dielectric(cos, self.eta).reflectance,
-            Some(t) => {
-                let x = cos.clamp(0.0, 1.0) * (TRANSMITTANCE_RES - 1) as f32;
-                let i = (x as usize).min(TRANSMITTANCE_RES - 2);
-                let f = x - i as f32;
-                t[i] * (1.0 - f) + t[i + 1] * f
-            }
-        }
+        coating_transmittance(self.transmittance, self.eta, cos)
     }
 
     fn specular_weight(&self) -> f32 {

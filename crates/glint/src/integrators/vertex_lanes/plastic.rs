@@ -4,10 +4,10 @@
 //! chosen by the lobe number: the coating's mirror reflection (a delta sample) or the
 //! cosine-sampled diffuse base, and the next ray.
 //!
-//! What both coatings share (the lobe probability, the transmittance through the coating, the
-//! base's albedo and its diffuse term) is [`Coating`]; a rough coating would add its
-//! microfacet lobe to the value and density towards the light and its own reflection sample,
-//! and replace the transmittance `1 - F` by its table.
+//! What both coatings share (the BSDF's columns, [`PlasticColumns`]; the lobe probability,
+//! the transmittance through the coating, the base's albedo and its diffuse term,
+//! [`Coating`]) is here; the rough coating's kernel (`rough_plastic`) adds its microfacet lobe
+//! and replaces the transmittance `1 - F` by its table.
 
 use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
@@ -36,12 +36,8 @@ pub(crate) struct PlasticChunk {
     pub path: [u32; MAX_LANES],
     pub(super) v: VertexColumns,
     pub(super) throughput: Column3,
-    // In: the BSDF (`PlasticParams`' fields).
-    pub(super) diffuse: Column3,
-    pub(super) specular: Column3,
-    pub(super) eta: Column,
-    pub(super) fdr_internal: Column,
-    pub(super) nonlinear: Column,
+    /// In: the BSDF.
+    pub(super) bsdf: PlasticColumns,
     /// The light sample in, the shadow ray out.
     pub(super) ne: NextEventColumns,
     // In: the BSDF's lobe number and square sample.
@@ -72,18 +68,14 @@ impl PlasticChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        debug_assert!(bsdf.dist.is_none(), "rough plastics step through the scalar code");
+        debug_assert!(bsdf.dist.is_none(), "rough plastics wait in `RoughPlasticChunk`");
         let i = self.len;
         self.len += 1;
         self.path[i] = path_index;
         self.v.put_ray(i, path.ray.dir, si.p);
         self.v.put_frame(i, si.ng, frame);
         put3(&mut self.throughput, i, path.throughput().to_array());
-        put3(&mut self.diffuse, i, bsdf.diffuse.to_array());
-        put3(&mut self.specular, i, bsdf.specular.to_array());
-        self.eta[i] = bsdf.eta;
-        self.fdr_internal[i] = bsdf.fdr_internal;
-        self.nonlinear[i] = flag(bsdf.nonlinear);
+        self.bsdf.put(i, bsdf);
         self.ne.put(i, light);
         self.u_lobe[i] = rng.next_f32();
         let u = rng.next_2d();
@@ -143,25 +135,48 @@ fn plastic_chunk<L: Lanes>(l: L, c: &mut PlasticChunk, light_only: bool) {
     }
 }
 
+/// `PlasticParams`' fields that both coatings' kernels read, one plastic per lane. Flags are
+/// 1.0 (true) or 0.0.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct PlasticColumns {
+    pub diffuse: Column3,
+    pub specular: Column3,
+    pub eta: Column,
+    pub fdr_internal: Column,
+    pub nonlinear: Column,
+}
+
+impl PlasticColumns {
+    /// Lane `i`'s plastic (its coating's roughness and table aside).
+    pub fn put(&mut self, i: usize, p: &PlasticParams) {
+        put3(&mut self.diffuse, i, p.diffuse.to_array());
+        put3(&mut self.specular, i, p.specular.to_array());
+        self.eta[i] = p.eta;
+        self.fdr_internal[i] = p.fdr_internal;
+        self.nonlinear[i] = flag(p.nonlinear);
+    }
+}
+
 /// The coating over one vector of lanes, for the viewing direction's cosine `wo.z`: what
 /// `PlasticParams`' `prob_specular` and `diffuse_eval` compute from `wo` alone.
-struct Coating<F> {
-    eta: F,
+pub(super) struct Coating<F> {
+    pub eta: F,
     /// `eta * eta`.
-    eta2: F,
+    pub eta2: F,
     /// `fresnel_dielectric(wo.z, eta).reflectance`.
-    fresnel_o: F,
-    /// `coating_transmittance(wo.z)`: `1 - fresnel_o` for a smooth coating.
-    to: F,
+    pub fresnel_o: F,
+    /// `coating_transmittance(wo.z)`: `1 - fresnel_o` for a smooth coating (`new`'s), the
+    /// table's value for a rough one (which its kernel puts here).
+    pub to: F,
     /// `prob_specular(wo.z)`.
-    ps: F,
+    pub ps: F,
     /// The base's albedo under the internal-scattering correction (linear or nonlinear).
-    albedo: V3<F>,
+    pub albedo: V3<F>,
 }
 
 impl<F: Copy> Coating<F> {
     #[inline(always)]
-    fn new<L: Lanes<F = F>>(l: L, c: &PlasticChunk, base: usize, wo_z: F) -> Coating<F> {
+    pub fn new<L: Lanes<F = F>>(l: L, c: &PlasticColumns, base: usize, wo_z: F) -> Coating<F> {
         let (zero, one, three) = (l.splat(0.0), l.splat(1.0), l.splat(3.0));
         let eta = l.load(&c.eta[base..]);
         let diffuse = load3(l, &c.diffuse, base);
@@ -194,11 +209,18 @@ impl<F: Copy> Coating<F> {
         }
     }
 
-    /// `diffuse_eval(wo, wi)` for the incident cosine `wi_z`:
-    /// `albedo * (INV_PI * wi.z * to * ti / (eta * eta))`, in that order.
+    /// `diffuse_eval(wo, wi)` of a smooth coating for the incident cosine `wi_z`.
     #[inline(always)]
     fn diffuse_eval<L: Lanes<F = F>>(&self, l: L, wi_z: F) -> V3<F> {
         let ti = l.sub(l.splat(1.0), fresnel_dielectric(l, wi_z, self.eta).reflectance);
+        self.diffuse_eval_through(l, wi_z, ti)
+    }
+
+    /// `diffuse_eval(wo, wi)` for the incident cosine `wi_z`, where the coating transmits `ti`
+    /// (`coating_transmittance(wi.z)`): `albedo * (INV_PI * wi.z * to * ti / (eta * eta))`, in
+    /// that order.
+    #[inline(always)]
+    pub fn diffuse_eval_through<L: Lanes<F = F>>(&self, l: L, wi_z: F, ti: F) -> V3<F> {
         let k = l.div(l.mul(l.mul(l.mul(l.splat(INV_PI), wi_z), self.to), ti), self.eta2);
         scale(l, self.albedo, k)
     }
@@ -211,7 +233,7 @@ fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, light_only: 
     let wo = c.v.wo_local(l, base);
     let n = load3(l, &c.v.n, base);
     let thr = load3(l, &c.throughput, base);
-    let coat = Coating::new(l, c, base, wo.z);
+    let coat = Coating::new(l, &c.bsdf, base, wo.z);
     // `eval`, `pdf` and `sample` give nothing below the surface (NaN goes on).
     let wo_below = l.le(wo.z, zero);
 
@@ -229,7 +251,7 @@ fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, light_only: 
     // density `(1 - ps) * cosine_hemisphere_pdf(wi.z)`, none where `wi.z <= 0`.
     let mirror = l.lt(l.load(&c.u_lobe[base..]), coat.ps);
     let reflected = V3 { x: l.neg(wo.x), y: l.neg(wo.y), z: wo.z };
-    let w_mirror = scale(l, load3(l, &c.specular, base), l.div(coat.fresnel_o, coat.ps));
+    let w_mirror = scale(l, load3(l, &c.bsdf.specular, base), l.div(coat.fresnel_o, coat.ps));
     let d = cosine_hemisphere(l, l.load(&c.u[0][base..]), l.load(&c.u[1][base..]));
     // `d.z` is never -0.0 (a square root of a `max` with +0).
     let pdf_d = l.mul(l.sub(one, coat.ps), cosine_hemisphere_pdf(l, d.z));

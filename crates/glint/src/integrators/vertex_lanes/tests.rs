@@ -13,6 +13,7 @@ use super::plastic::PlasticChunk;
 use super::principled::PrincipledChunk;
 use super::rough::RoughChunk;
 use super::rough_dielectric::RoughDielectricChunk;
+use super::rough_plastic::RoughPlasticChunk;
 use super::smooth::{Smooth, SmoothChunk};
 use super::*;
 use crate::bsdf::{Microfacet, MicrofacetKind};
@@ -1047,6 +1048,132 @@ fn every_lane_scatters_off_rough_dielectrics_as_the_one_path_code_does() {
             check_rough_dielectric(LaneIsa::Avx512);
         } else {
             eprintln!("no AVX-512F on this CPU: the sixteen-lane rough dielectric kernel is not tested here");
+        }
+    }
+}
+
+/// A rough plastic for the rough plastic kernel. The coating's tables are interned per
+/// distribution and index and cost a quadrature each, so the coatings come from a few:
+/// GGX and Beckmann, isotropic (at the clamp's bound, moderate, huge) and anisotropic, index
+/// matched, below and above 1. Now and then the distribution is swapped for any of
+/// `microfacet`'s (NaN, infinite, zero, unclamped roughness) under the same table, the index
+/// for a special one, or the table dropped (`1 - F`, the free function's other branch): the
+/// lanes must follow whatever the parameters hold. The bases and coats are
+/// `plastic_params`'.
+fn rough_plastic_params(rng: &mut Rng) -> PlasticParams {
+    const ALPHAS: [(f32, f32); 4] = [(1e-4, 1e-4), (0.3, 0.3), (0.05, 0.6), (3.0, 3.0)];
+    const ETAS: [f32; 4] = [1.0, 1.0 / 1.5, 1.49, 2.5];
+    let kind = if rng.next_u32().is_multiple_of(2) { MicrofacetKind::Ggx } else { MicrofacetKind::Beckmann };
+    let (au, av) = ALPHAS[(rng.next_u32() % 4) as usize];
+    let eta = ETAS[(rng.next_u32() % 4) as usize];
+    let colours = plastic_params(rng);
+    let p = PlasticParams::new(colours.diffuse, colours.specular, eta, Some(Microfacet::anisotropic(kind, au, av)));
+    let mut p = PlasticParams { nonlinear: colours.nonlinear, ..p };
+    match rng.next_u32() % 24 {
+        0..=2 => p.dist = Some(microfacet(rng)),
+        3 => p.eta = value(rng, 2.0, 4).abs(),
+        4 => p.transmittance = None,
+        _ => {}
+    }
+    p
+}
+
+/// The specular lobe's probability `prob_specular(wo.z)` of a plastic (the delta sample's
+/// density of its smooth twin at lobe number 0), or None where the scalar code samples no
+/// lobe with it (`wo` below, or a probability of 0).
+fn plastic_ps(v: &Vertex, p: &PlasticParams) -> Option<f32> {
+    let wo = v.frame.to_local(-v.dir);
+    let smooth = Bsdf::Plastic(PlasticParams { dist: None, ..*p });
+    smooth.sample(wo, 0.0, v.u).filter(|bs| bs.delta).map(|bs| bs.pdf)
+}
+
+/// The rough plastic's lanes against `PathState::scatter`'s one-path code for
+/// `Bsdf::Plastic` with a rough coating (`reference_scatter`: `eval`, `pdf`,
+/// `power_heuristic`, `shadow_ray`, then `sample`, `Frame::to_world` and `spawn_ray`).
+fn check_rough_plastic(isa: LaneIsa) {
+    let lanes = isa.lanes();
+    let mut rng = Rng::new(47, lanes as u64);
+    let (mut shadows, mut coat, mut beckmann, mut base, mut ends, mut total) = (0, 0, 0, 0, 0, 0);
+    for round in 0..4000 {
+        let light_only = round % 5 == 0;
+        let mut chunk = RoughPlasticChunk::default();
+        let used = if round % 7 == 0 { 1 + round % lanes } else { lanes };
+        let mut want = Vec::new();
+        for i in 0..used {
+            let v = vertex(&mut rng);
+            let p = rough_plastic_params(&mut rng);
+            // The lobe number at the specular probability and either side of it now and then.
+            let u_lobe = plastic_u_lobe(&mut rng, &v, &PlasticParams { dist: None, ..p });
+            let si = surface(&v);
+            let mut sampler = Sampler::from_rng(Rng::new(5, (round * lanes + i) as u64));
+            let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
+            let dist = p.dist.expect("a rough coating");
+            chunk.push(i as u32, &path, &si, &v.frame, &p, &dist, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
+            // The vertex's own throughput, lobe number and square, in place of a new path's
+            // and the sampler's.
+            put3(&mut chunk.throughput, i, v.throughput.to_array());
+            chunk.u_lobe[i] = u_lobe;
+            chunk.u[0][i] = v.u[0];
+            chunk.u[1][i] = v.u[1];
+            let coat_lobe = plastic_ps(&v, &p).is_some_and(|ps| u_lobe < ps);
+            want.push((reference_scatter(&v, &Bsdf::Plastic(p), u_lobe, v.u, light_only), coat_lobe, v, p));
+        }
+        chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
+        for (i, (w, coat_lobe, v, p)) in want.iter().enumerate() {
+            let c = &chunk;
+            let shadow = (c.ne.shadow[i] != 0.0).then(|| {
+                (
+                    bits(get3(&c.ne.shadow_origin, i)),
+                    bits(get3(&c.ne.shadow_dir, i)),
+                    bits1(c.ne.shadow_t_max[i]),
+                    bits(get3(&c.ne.contribution, i)),
+                    bits1(c.ne.mis_weight[i]),
+                )
+            });
+            let next = (c.sampled[i] != 0.0).then(|| {
+                (
+                    bits(get3(&c.next_origin, i)),
+                    bits(get3(&c.next_dir, i)),
+                    bits(get3(&c.weight, i)),
+                    bits1(c.pdf[i]),
+                    // A rough plastic's samples keep the index (`go_on`'s eta of 1).
+                    1.0f32.to_bits(),
+                )
+            });
+            assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {p:?} u_lobe {}", c.u_lobe[i]);
+            total += 1;
+            shadows += w.0.is_some() as u32;
+            match (w.1.is_some(), coat_lobe) {
+                (false, _) => ends += 1,
+                (true, true) => {
+                    coat += 1;
+                    beckmann += p.dist.is_some_and(|d| d.kind == MicrofacetKind::Beckmann) as u32;
+                }
+                (true, false) => base += 1,
+            }
+        }
+    }
+    assert!(
+        shadows > total / 10 && coat > total / 20 && beckmann > total / 50 && base > total / 10 && ends > total / 10,
+        "{isa:?}: {shadows} shadow rays, {coat} coating samples ({beckmann} Beckmann), {base} base samples, \
+         {ends} ends of {total}"
+    );
+}
+
+#[test]
+fn every_lane_scatters_off_rough_plastic_as_the_one_path_code_does() {
+    check_rough_plastic(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check_rough_plastic(LaneIsa::Avx2);
+        } else {
+            eprintln!("no AVX2 on this CPU: the eight-lane rough plastic kernel is not tested here");
+        }
+        if Avx512x16::new().is_some() {
+            check_rough_plastic(LaneIsa::Avx512);
+        } else {
+            eprintln!("no AVX-512F on this CPU: the sixteen-lane rough plastic kernel is not tested here");
         }
     }
 }

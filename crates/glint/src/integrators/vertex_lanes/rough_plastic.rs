@@ -1,0 +1,235 @@
+//! The rough plastic's vertex in lanes, as `PathState::scatter` computes it for
+//! `Bsdf::Plastic` with a rough coating (`dist` Some): the BSDF's value and density towards
+//! the light (the diffuse base under the coating's tabulated transmittance plus the coating's
+//! microfacet reflection), the MIS weight and the shadow ray, then the lobe chosen by the
+//! lobe number (a visible normal of the coating and the direction it reflects `wo` to, or the
+//! cosine-sampled base), the value and density of both lobes there (`BsdfSample::non_delta`'s
+//! rules) and the next ray.
+//!
+//! A chunk of its own rather than lanes of the smooth plastic's: the two share the coating's
+//! lobe probability and diffuse term ([`Coating`]) but not their samples (a delta reflection
+//! with the base's density alone against a non-delta one with both lobes' value and density),
+//! and a smooth plastic's vector never computes a microfacet term this way.
+//!
+//! The transmittance table is a gather from each lane's own table: each lane makes the scalar
+//! call `materials::plastic::coating_transmittance` (the very function `PlasticParams` calls),
+//! three times per vertex (at `wo`, towards the light and at the sampled direction), and only
+//! for the lanes that read the result.
+
+use super::columns::{NextEventColumns, VertexColumns};
+use super::lane_math::*;
+use super::microfacet::{per_lane, LaneMicrofacet, MicrofacetColumns};
+use super::plastic::{Coating, PlasticColumns};
+use super::smooth::fresnel_dielectric;
+use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
+use super::{get3, put3, Column, Column3, LaneIsa};
+use crate::bsdf::Microfacet;
+use crate::describe::{PathSettings, Strategy};
+use crate::integrators::estimators::PrevEvent;
+use crate::integrators::path::PathState;
+use crate::integrators::Counters;
+use crate::lights::LightSample;
+use crate::materials::{coating_transmittance, PlasticParams, TRANSMITTANCE_RES};
+#[cfg(target_arch = "x86_64")]
+use crate::math::lanes::{Avx2x8, Avx512x16};
+use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::{Frame, Ray, Rgb};
+use crate::sampling::Sampler;
+use crate::world::SurfaceInteraction;
+
+/// Up to [`MAX_LANES`] vertices of rough plastics, one per lane.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct RoughPlasticChunk {
+    pub len: usize,
+    /// Which path each lane is (the caller's index).
+    pub path: [u32; MAX_LANES],
+    pub(super) v: VertexColumns,
+    pub(super) throughput: Column3,
+    // In: the BSDF: the plastic, its coating's distribution and transmittance table.
+    pub(super) bsdf: PlasticColumns,
+    pub(super) dist: MicrofacetColumns,
+    pub(super) table: [Option<&'static [f32; TRANSMITTANCE_RES]>; MAX_LANES],
+    /// The light sample in, the shadow ray out.
+    pub(super) ne: NextEventColumns,
+    // In: the BSDF's lobe number and square sample.
+    pub(super) u_lobe: Column,
+    pub(super) u: [Column; 2],
+    // Out: the next ray, the sample's weight and density (`sampled` 0 where the path ends;
+    // a rough plastic's samples are never delta).
+    pub(super) sampled: Column,
+    pub(super) weight: Column3,
+    pub(super) pdf: Column,
+    pub(super) next_origin: Column3,
+    pub(super) next_dir: Column3,
+}
+
+impl RoughPlasticChunk {
+    /// Adds a path's vertex as the next lane: its plastic `bsdf` with the coating's
+    /// distribution `dist` (`bsdf.dist`), its light sample (drawn before, as
+    /// `PathState::scatter` draws it), then the lobe number and the square drawn from `rng` in
+    /// `scatter`'s order.
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(
+        &mut self,
+        path_index: u32,
+        path: &PathState,
+        si: &SurfaceInteraction,
+        frame: &Frame,
+        bsdf: &PlasticParams,
+        dist: &Microfacet,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) {
+        let i = self.len;
+        self.len += 1;
+        self.path[i] = path_index;
+        self.v.put_ray(i, path.ray.dir, si.p);
+        self.v.put_frame(i, si.ng, frame);
+        put3(&mut self.throughput, i, path.throughput().to_array());
+        self.bsdf.put(i, bsdf);
+        self.dist.put(i, dist);
+        self.table[i] = bsdf.transmittance;
+        self.ne.put(i, light);
+        self.u_lobe[i] = rng.next_f32();
+        let u = rng.next_2d();
+        self.u[0][i] = u[0];
+        self.u[1][i] = u[1];
+    }
+
+    /// Runs the kernel over the chunk's lanes on `isa`.
+    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
+        let light_only = strategy == Strategy::Light;
+        match isa {
+            LaneIsa::One => rough_plastic_chunk(One, self, light_only),
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
+            LaneIsa::Avx2 => unsafe { rough_plastic_chunk_avx2(self, light_only) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
+            LaneIsa::Avx512 => unsafe { rough_plastic_chunk_avx512(self, light_only) },
+        }
+    }
+
+    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
+        self.ne.finish(i, path, c);
+        if self.sampled[i] == 0.0 {
+            return;
+        }
+        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
+        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.v.p, i) };
+        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
+        path.go_on(s, weight, 1.0, prev, ray, rng);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn rough_plastic_chunk_avx2(chunk: &mut RoughPlasticChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX2.
+    rough_plastic_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+unsafe fn rough_plastic_chunk_avx512(chunk: &mut RoughPlasticChunk, light_only: bool) {
+    // SAFETY: this function's contract is that the CPU has AVX-512F.
+    rough_plastic_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
+}
+
+#[inline(always)]
+fn rough_plastic_chunk<L: Lanes>(l: L, c: &mut RoughPlasticChunk, light_only: bool) {
+    let mut base = 0;
+    while base < c.len {
+        // The lanes that hold vertices (the rest compute on stale columns, and make no scalar
+        // calls but the distribution's).
+        let live = (1u32 << (c.len - base).min(L::N)) - 1;
+        rough_plastic_lanes(l, c, base, live, light_only);
+        base += L::N;
+    }
+}
+
+/// `coating_transmittance(cos)` of the lanes set in `which` (lane i in bit i; 0 in the
+/// others): the scalar function on each lane's table, index and cosine.
+#[inline(always)]
+fn transmittance<L: Lanes>(l: L, c: &RoughPlasticChunk, base: usize, which: u32, eta: L::F, cos: L::F) -> L::F {
+    let [t] = per_lane(l, which, [eta, cos], |i, [eta, cos]| [coating_transmittance(c.table[base + i], eta, cos)]);
+    t
+}
+
+/// `PlasticParams::eval` and `pdf` of a rough coating at (`wo`, `wi`), sharing their half
+/// vector and D; the lanes in `live` look their transmittance up.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn eval_pdf<L: Lanes>(
+    l: L,
+    c: &RoughPlasticChunk,
+    base: usize,
+    live: u32,
+    dist: &LaneMicrofacet<L>,
+    coat: &Coating<L::F>,
+    wo: V3<L::F>,
+    wi: V3<L::F>,
+) -> (V3<L::F>, L::F) {
+    let (zero, one, four) = (l.splat(0.0), l.splat(1.0), l.splat(4.0));
+    let below = l.or(l.le(wo.z, zero), l.le(wi.z, zero));
+    // `diffuse_eval(wo, wi)`.
+    let ti = transmittance(l, c, base, live & !l.bits(below), coat.eta, wi.z);
+    let diffuse = coat.diffuse_eval_through(l, wi.z, ti);
+    // The coating: `specular * (f * d.d(h) * d.g(wo, wi, h) / (4.0 * wo.z))`, `f` the Fresnel
+    // reflectance at `wo.dot(h)`, `h` the normalized `wo + wi`; added to the base's.
+    let h = normalize(l, add3(l, wo, wi));
+    let d = dist.d(l, h);
+    let cos_oh = dot(l, wo, h);
+    let fr = fresnel_dielectric(l, cos_oh, coat.eta).reflectance;
+    let k = l.div(l.mul(l.mul(fr, d), dist.g(l, wo, wi, h)), l.mul(four, wo.z));
+    let f = add3(l, diffuse, scale(l, load3(l, &c.bsdf.specular, base), k));
+    let f = select3(l, below, V3 { x: zero, y: zero, z: zero }, f);
+    // `(1 - ps) * cosine_hemisphere_pdf(wi.z)` (`wi.z` is above 0 or NaN where it counts),
+    // plus `ps * d.pdf_wm(wo, h) / (4.0 * wo.dot(h))`.
+    let p_base = l.mul(l.sub(one, coat.ps), cosine_hemisphere_pdf(l, wi.z));
+    let p_coat = l.div(l.mul(coat.ps, dist.pdf_wm_given_d(l, wo, h, d)), l.mul(four, cos_oh));
+    (f, l.select(below, zero, l.add(p_base, p_coat)))
+}
+
+/// One vector of the chunk's lanes, from `base`: `PathState::scatter` for a rough plastic.
+#[inline(always)]
+fn rough_plastic_lanes<L: Lanes>(l: L, c: &mut RoughPlasticChunk, base: usize, live: u32, light_only: bool) {
+    let (zero, one) = (l.splat(0.0), l.splat(1.0));
+    let wo = c.v.wo_local(l, base);
+    let dist = c.dist.lanes(l, base);
+    // `eval`, `pdf` and `sample` give nothing below the surface (NaN goes on).
+    let above = l.not(l.le(wo.z, zero));
+    let mut coat = Coating::new(l, &c.bsdf, base, wo.z);
+    coat.to = transmittance(l, c, base, live & l.bits(above), coat.eta, wo.z);
+
+    // Next-event estimation: the BSDF towards the light, then what `NextEventColumns::lanes`
+    // makes of it.
+    let thr = load3(l, &c.throughput, base);
+    let light_wi = c.v.local(l, base, load3(l, &c.ne.light_wi, base));
+    let (f, bsdf_pdf) = eval_pdf(l, c, base, live, &dist, &coat, wo, light_wi);
+    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+
+    // `sample`: where `u_lobe < ps`, a visible normal of the coating and `h * (2.0 *
+    // wo.dot(h)) - wo` (not normalized); else the cosine-sampled base. Then `finish`: both
+    // lobes' value and density there.
+    let coat_lobe = l.lt(l.load(&c.u_lobe[base..]), coat.ps);
+    let u = [l.load(&c.u[0][base..]), l.load(&c.u[1][base..])];
+    let h = dist.sample_wm(l, wo, u, live & l.bits(l.and(above, coat_lobe)));
+    let reflected = sub3(l, scale(l, h, l.mul(l.splat(2.0), dot(l, wo, h))), wo);
+    let wi = select3(l, coat_lobe, reflected, cosine_hemisphere(l, u[0], u[1]));
+    let (value, pdf) = eval_pdf(l, c, base, live & l.bits(above), &dist, &coat, wo, wi);
+    // `BsdfSample::non_delta`: none where `wi.z <= 0` or without density; the weight is
+    // `value / pdf`, a product by the reciprocal. Then `scatter` ends the path on a black one.
+    let kept = l.and(l.and_not(above, l.le(wi.z, zero)), l.gt(pdf, zero));
+    let weight = scale(l, value, l.div(one, pdf));
+    let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
+    let sampled = l.and_not(kept, black);
+    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
+    store3(l, weight, &mut c.weight, base);
+    l.store(pdf, &mut c.pdf[base..]);
+    // `frame.to_world(wi)`, then `spawn_ray`.
+    let wi_world = c.v.world(l, base, wi);
+    store3(l, wi_world, &mut c.next_dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next_origin, base);
+}
