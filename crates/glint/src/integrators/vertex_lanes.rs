@@ -33,6 +33,62 @@
 //! read by the scalar function per lane), and the principled BSDF with all its lobes
 //! (`principled`). Every other BSDF steps through `PathState::scatter`, one path at a time.
 
+/// `run(isa, strategy)` for the chunk type `$chunk` whose kernel `$lanes(l, chunk, base, live,
+/// light_only)` shades one vector of lanes from `base` (`live`: the lanes that hold vertices,
+/// lane i in bit i; the others compute on stale columns and nothing reads their results): the
+/// kernel instantiated for each instruction set behind its `#[target_feature]` entry point,
+/// the one `LaneIsa::detect` chose run.
+macro_rules! lane_kernel {
+    ($chunk:ty, $lanes:ident) => {
+        impl $chunk {
+            /// Runs the kernel over the chunk's lanes on `isa`.
+            pub fn run(
+                &mut self,
+                isa: $crate::integrators::vertex_lanes::LaneIsa,
+                strategy: $crate::describe::Strategy,
+            ) {
+                use $crate::integrators::vertex_lanes::LaneIsa;
+                use $crate::math::lanes::Lanes;
+
+                #[inline(always)]
+                fn every_vector<L: Lanes>(l: L, c: &mut $chunk, light_only: bool) {
+                    let mut base = 0;
+                    while base < c.len {
+                        let live = (1u32 << (c.len - base).min(L::N)) - 1;
+                        $lanes(l, c, base, live, light_only);
+                        base += L::N;
+                    }
+                }
+
+                #[cfg(target_arch = "x86_64")]
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn avx2(c: &mut $chunk, light_only: bool) {
+                    // SAFETY: this function's contract is that the CPU has AVX2.
+                    every_vector(unsafe { $crate::math::lanes::Avx2x8::new_unchecked() }, c, light_only)
+                }
+
+                #[cfg(target_arch = "x86_64")]
+                #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+                unsafe fn avx512(c: &mut $chunk, light_only: bool) {
+                    // SAFETY: this function's contract is that the CPU has AVX-512F.
+                    every_vector(unsafe { $crate::math::lanes::Avx512x16::new_unchecked() }, c, light_only)
+                }
+
+                let light_only = strategy == $crate::describe::Strategy::Light;
+                match isa {
+                    LaneIsa::One => every_vector($crate::math::lanes::One, self, light_only),
+                    #[cfg(target_arch = "x86_64")]
+                    // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
+                    LaneIsa::Avx2 => unsafe { avx2(self, light_only) },
+                    #[cfg(target_arch = "x86_64")]
+                    // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
+                    LaneIsa::Avx512 => unsafe { avx512(self, light_only) },
+                }
+            }
+        }
+    };
+}
+
 mod columns;
 mod diffuse;
 mod lane_math;

@@ -6,15 +6,13 @@
 use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use super::{flag, get3, put3, Column, Column3, LaneIsa, MeshHit};
-use crate::describe::{PathSettings, Strategy};
+use super::{flag, get3, put3, Column, Column3, MeshHit};
+use crate::describe::PathSettings;
 use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
-#[cfg(target_arch = "x86_64")]
-use crate::math::lanes::{Avx2x8, Avx512x16};
-use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::{Frame, Ray, Rgb, Vec3, INV_PI};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -130,20 +128,6 @@ impl DiffuseChunk {
         i
     }
 
-    /// Runs the kernel over the chunk's lanes on `isa`.
-    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
-        let light_only = strategy == Strategy::Light;
-        match isa {
-            LaneIsa::One => diffuse_chunk(One, self, light_only),
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
-            LaneIsa::Avx2 => unsafe { diffuse_chunk_avx2(self, light_only) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
-            LaneIsa::Avx512 => unsafe { diffuse_chunk_avx512(self, light_only) },
-        }
-    }
-
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
@@ -157,35 +141,12 @@ impl DiffuseChunk {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn diffuse_chunk_avx2(chunk: &mut DiffuseChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX2.
-    diffuse_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-unsafe fn diffuse_chunk_avx512(chunk: &mut DiffuseChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX-512F.
-    diffuse_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
-}
-
-/// Every lane of the chunk in vectors of `L::N` (the unused lanes of the last vector compute
-/// on whatever their columns hold, and nothing reads their results).
-#[inline(always)]
-fn diffuse_chunk<L: Lanes>(l: L, c: &mut DiffuseChunk, light_only: bool) {
-    let mut base = 0;
-    while base < c.len {
-        mesh_frames(l, c, base);
-        diffuse_lanes(l, c, base, light_only);
-        base += L::N;
-    }
-}
+lane_kernel!(DiffuseChunk, diffuse_lanes);
 
 /// One vector of the chunk's lanes, from `base`: `PathState::scatter` for a Lambertian BSDF.
 #[inline(always)]
-fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, light_only: bool) {
+fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, _live: u32, light_only: bool) {
+    mesh_frames(l, c, base);
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let inv_pi = l.splat(INV_PI);

@@ -13,16 +13,14 @@ use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
 use super::smooth::fresnel_dielectric;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use super::{flag, get3, put3, Column, Column3, LaneIsa};
-use crate::describe::{PathSettings, Strategy};
+use super::{flag, get3, put3, Column, Column3};
+use crate::describe::PathSettings;
 use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::PlasticParams;
-#[cfg(target_arch = "x86_64")]
-use crate::math::lanes::{Avx2x8, Avx512x16};
-use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::{Frame, Ray, Rgb, INV_PI};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -83,20 +81,6 @@ impl PlasticChunk {
         self.u[1][i] = u[1];
     }
 
-    /// Runs the kernel over the chunk's lanes on `isa`.
-    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
-        let light_only = strategy == Strategy::Light;
-        match isa {
-            LaneIsa::One => plastic_chunk(One, self, light_only),
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
-            LaneIsa::Avx2 => unsafe { plastic_chunk_avx2(self, light_only) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
-            LaneIsa::Avx512 => unsafe { plastic_chunk_avx512(self, light_only) },
-        }
-    }
-
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
@@ -110,30 +94,7 @@ impl PlasticChunk {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn plastic_chunk_avx2(chunk: &mut PlasticChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX2.
-    plastic_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-unsafe fn plastic_chunk_avx512(chunk: &mut PlasticChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX-512F.
-    plastic_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
-}
-
-/// Every lane of the chunk in vectors of `L::N` (the unused lanes of the last vector compute
-/// on whatever their columns hold, and nothing reads their results).
-#[inline(always)]
-fn plastic_chunk<L: Lanes>(l: L, c: &mut PlasticChunk, light_only: bool) {
-    let mut base = 0;
-    while base < c.len {
-        plastic_lanes(l, c, base, light_only);
-        base += L::N;
-    }
-}
+lane_kernel!(PlasticChunk, plastic_lanes);
 
 /// `PlasticParams`' fields that both coatings' kernels read, one plastic per lane. Flags are
 /// 1.0 (true) or 0.0.
@@ -228,7 +189,7 @@ impl<F: Copy> Coating<F> {
 
 /// One vector of the chunk's lanes, from `base`: `PathState::scatter` for a smooth plastic.
 #[inline(always)]
-fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, light_only: bool) {
+fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, _live: u32, light_only: bool) {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
     let wo = c.v.wo_local(l, base);
     let n = load3(l, &c.v.n, base);

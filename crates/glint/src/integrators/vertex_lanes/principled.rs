@@ -12,16 +12,14 @@
 use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
 use super::microfacet::{ggx_visible_normal_unit, per_lane};
-use super::{get3, put3, Column, Column3, LaneIsa};
-use crate::describe::{PathSettings, Strategy};
+use super::{get3, put3, Column, Column3};
+use crate::describe::PathSettings;
 use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::Principled;
-#[cfg(target_arch = "x86_64")]
-use crate::math::lanes::{Avx2x8, Avx512x16};
-use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::{Ray, Rgb, INV_PI, PI};
 use crate::sampling::Sampler;
 
@@ -103,20 +101,6 @@ impl PrincipledChunk {
         self.u[1][i] = u[1];
     }
 
-    /// Runs the kernel over the chunk's lanes on `isa`.
-    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
-        let light_only = strategy == Strategy::Light;
-        match isa {
-            LaneIsa::One => principled_chunk(One, self, light_only),
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
-            LaneIsa::Avx2 => unsafe { principled_chunk_avx2(self, light_only) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
-            LaneIsa::Avx512 => unsafe { principled_chunk_avx512(self, light_only) },
-        }
-    }
-
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
@@ -130,30 +114,11 @@ impl PrincipledChunk {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn principled_chunk_avx2(chunk: &mut PrincipledChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX2.
-    principled_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
-}
+lane_kernel!(PrincipledChunk, principled_lanes);
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-unsafe fn principled_chunk_avx512(chunk: &mut PrincipledChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX-512F.
-    principled_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
-}
-
-#[inline(always)]
-fn principled_chunk<L: Lanes>(l: L, c: &mut PrincipledChunk, light_only: bool) {
-    let mut base = 0;
-    while base < c.len {
-        principled_lanes(l, c, base, light_only);
-        base += L::N;
-    }
-}
-
-/// Every lane's bit.
+/// Every lane's bit: the principled kernel's scalar calls (`sin`, `cos`, `powf`, `ln`) are
+/// pure, so the stale lanes of a part-full vector make them too rather than thread `live`
+/// through every lobe.
 #[inline(always)]
 fn all<L: Lanes>() -> u32 {
     u32::MAX >> (32 - L::N)
@@ -161,7 +126,7 @@ fn all<L: Lanes>() -> u32 {
 
 /// One vector of the chunk's lanes, from `base`: `PathState::scatter` for `Principled`.
 #[inline(always)]
-fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, light_only: bool) {
+fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, _live: u32, light_only: bool) {
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let b = Params::load(l, c, base);

@@ -13,17 +13,15 @@ use super::columns::{NextEventColumns, VertexColumns};
 use super::lane_math::*;
 use super::microfacet::{LaneMicrofacet, MicrofacetColumns};
 use super::smooth::fresnel_dielectric;
-use super::{get3, put3, Column, Column3, LaneIsa};
+use super::{get3, put3, Column, Column3};
 use crate::bsdf::lobe_weight;
-use crate::describe::{PathSettings, Strategy};
+use crate::describe::PathSettings;
 use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::RoughDielectric;
-#[cfg(target_arch = "x86_64")]
-use crate::math::lanes::{Avx2x8, Avx512x16};
-use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -89,20 +87,6 @@ impl RoughDielectricChunk {
         self.u[1][i] = u[1];
     }
 
-    /// Runs the kernel over the chunk's lanes on `isa`.
-    pub fn run(&mut self, isa: LaneIsa, strategy: Strategy) {
-        let light_only = strategy == Strategy::Light;
-        match isa {
-            LaneIsa::One => rough_dielectric_chunk(One, self, light_only),
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
-            LaneIsa::Avx2 => unsafe { rough_dielectric_chunk_avx2(self, light_only) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
-            LaneIsa::Avx512 => unsafe { rough_dielectric_chunk_avx512(self, light_only) },
-        }
-    }
-
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
@@ -116,31 +100,7 @@ impl RoughDielectricChunk {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn rough_dielectric_chunk_avx2(chunk: &mut RoughDielectricChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX2.
-    rough_dielectric_chunk(unsafe { Avx2x8::new_unchecked() }, chunk, light_only)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-unsafe fn rough_dielectric_chunk_avx512(chunk: &mut RoughDielectricChunk, light_only: bool) {
-    // SAFETY: this function's contract is that the CPU has AVX-512F.
-    rough_dielectric_chunk(unsafe { Avx512x16::new_unchecked() }, chunk, light_only)
-}
-
-#[inline(always)]
-fn rough_dielectric_chunk<L: Lanes>(l: L, c: &mut RoughDielectricChunk, light_only: bool) {
-    let mut base = 0;
-    while base < c.len {
-        // The lanes that hold vertices (the rest compute on stale columns, and need no
-        // visible-normal sample).
-        let live = (1u32 << (c.len - base).min(L::N)) - 1;
-        rough_dielectric_lanes(l, c, base, live, light_only);
-        base += L::N;
-    }
-}
+lane_kernel!(RoughDielectricChunk, rough_dielectric_lanes);
 
 /// One vector's rough dielectrics.
 struct Glass<L: Lanes> {

@@ -5,15 +5,13 @@
 
 use super::columns::VertexColumns;
 use super::lane_math::*;
-use super::{get3, put3, Column, Column3, LaneIsa};
-use crate::describe::{PathSettings, Strategy};
+use super::{get3, put3, Column, Column3};
+use crate::describe::PathSettings;
 use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::materials::{Conductor, Dielectric};
-#[cfg(target_arch = "x86_64")]
-use crate::math::lanes::{Avx2x8, Avx512x16};
-use crate::math::lanes::{Lanes, One, MAX_LANES};
+use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::{Frame, Ray, Rgb};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -86,20 +84,6 @@ impl SmoothChunk {
         let _u = rng.next_2d();
     }
 
-    /// Runs the kernel over the chunk's lanes on `isa` (a delta BSDF has no light sample, so
-    /// the strategy does not matter).
-    pub fn run(&mut self, isa: LaneIsa, _strategy: Strategy) {
-        match isa {
-            LaneIsa::One => smooth_chunk(One, self),
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX2 only where `Avx2x8::new` found it.
-            LaneIsa::Avx2 => unsafe { smooth_chunk_avx2(self) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `LaneIsa::detect` chose AVX-512 only where `Avx512x16::new` found it.
-            LaneIsa::Avx512 => unsafe { smooth_chunk_avx512(self) },
-        }
-    }
-
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, _c: &mut Counters) {
         if self.sampled[i] == 0.0 {
@@ -112,33 +96,12 @@ impl SmoothChunk {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn smooth_chunk_avx2(chunk: &mut SmoothChunk) {
-    // SAFETY: this function's contract is that the CPU has AVX2.
-    smooth_chunk(unsafe { Avx2x8::new_unchecked() }, chunk)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-unsafe fn smooth_chunk_avx512(chunk: &mut SmoothChunk) {
-    // SAFETY: this function's contract is that the CPU has AVX-512F.
-    smooth_chunk(unsafe { Avx512x16::new_unchecked() }, chunk)
-}
-
-#[inline(always)]
-fn smooth_chunk<L: Lanes>(l: L, c: &mut SmoothChunk) {
-    let mut base = 0;
-    while base < c.len {
-        smooth_lanes(l, c, base);
-        base += L::N;
-    }
-}
+lane_kernel!(SmoothChunk, smooth_lanes);
 
 /// One vector of the chunk's lanes, from `base`: `Conductor::sample` or `Dielectric::sample`
 /// (each computed only where a lane has it), then `frame.to_world` and `spawn_ray`.
 #[inline(always)]
-fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize) {
+fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize, _live: u32, _light_only: bool) {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
     let wo = c.v.wo_local(l, base);
     let (eta, spec) = (load3(l, &c.eta, base), load3(l, &c.specular, base));
