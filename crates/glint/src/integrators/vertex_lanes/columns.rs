@@ -4,11 +4,14 @@
 
 use super::lane_math::*;
 use super::{flag, get3, put3, Column, Column3};
+use crate::describe::PathSettings;
+use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::{PathState, ShadowQuery};
 use crate::integrators::Counters;
 use crate::lights::LightSample;
-use crate::math::lanes::Lanes;
+use crate::math::lanes::{Lanes, MAX_LANES};
 use crate::math::{Frame, Ray, Rgb, Vec3};
+use crate::sampling::Sampler;
 
 /// One vertex per lane: the ray that arrived, the point, the geometric normal and the
 /// shading frame.
@@ -167,5 +170,49 @@ impl NextEventColumns {
         store3(l, select3(l, finite, toward, light_wi), &mut self.shadow_dir, base);
         let t_max = l.mul(len, l.splat(1.0 - 1e-4));
         l.store(l.select(finite, t_max, l.splat(f32::INFINITY)), &mut self.shadow_t_max[base..]);
+    }
+}
+
+/// The sampled continuation per lane, what `PathState::scatter` hands to `go_on`: `sampled`
+/// 0 where the path ends; the sample's weight, density, kind (`delta` 1 or 0) and eta; the
+/// next ray. A new chunk's lanes have eta 1 and are not delta, so the kernels of BSDFs that
+/// never refract or sample a delta lobe leave those two alone.
+#[derive(Clone, Copy)]
+pub(crate) struct NextRayColumns {
+    pub sampled: Column,
+    pub weight: Column3,
+    pub pdf: Column,
+    pub delta: Column,
+    pub eta: Column,
+    pub origin: Column3,
+    pub dir: Column3,
+}
+
+impl Default for NextRayColumns {
+    fn default() -> NextRayColumns {
+        let zero = [0.0; MAX_LANES];
+        NextRayColumns {
+            sampled: zero,
+            weight: [zero; 3],
+            pdf: zero,
+            delta: zero,
+            eta: [1.0; MAX_LANES],
+            origin: [zero; 3],
+            dir: [zero; 3],
+        }
+    }
+}
+
+impl NextRayColumns {
+    /// Lane `i`'s continuation into its path from the point `p`, as the end of
+    /// `PathState::scatter` does (nothing where the path ends).
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, p: Vec3) {
+        if self.sampled[i] == 0.0 {
+            return;
+        }
+        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
+        let prev = PrevEvent { pdf: self.pdf[i], delta: self.delta[i] != 0.0, p };
+        let ray = Ray::new(get3(&self.origin, i), get3(&self.dir, i));
+        path.go_on(s, weight, self.eta[i], prev, ray, rng);
     }
 }

@@ -3,17 +3,16 @@
 //! shadow ray, the cosine sample and the next ray (`diffuse_lanes`), as
 //! `PathState::scatter` computes them for `Bsdf::Diffuse`.
 
-use super::columns::{NextEventColumns, VertexColumns};
+use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
 use super::lane_math::*;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use super::{flag, get3, put3, Column, Column3, MeshHit};
 use crate::describe::PathSettings;
-use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::math::lanes::{Lanes, MAX_LANES};
-use crate::math::{Frame, Ray, Rgb, Vec3, INV_PI};
+use crate::math::{Frame, Rgb, Vec3, INV_PI};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
 
@@ -43,11 +42,8 @@ pub(crate) struct DiffuseChunk {
     pub(super) uvs: [[Column; 2]; 3],
     pub(super) flip_normals: Column,
     pub(super) two_sided: Column,
-    // Out: the next ray (`sampled` 0 where the path ends).
-    pub(super) sampled: Column,
-    pub(super) next_origin: Column3,
-    pub(super) next_dir: Column3,
-    pub(super) pdf: Column,
+    // Out: the sampled continuation.
+    pub(super) next: NextRayColumns,
 }
 
 impl DiffuseChunk {
@@ -131,13 +127,7 @@ impl DiffuseChunk {
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
-        if self.sampled[i] == 0.0 {
-            return;
-        }
-        let weight = Rgb::from_array(get3(&self.reflectance, i).to_array());
-        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.v.p, i) };
-        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
-        path.go_on(s, weight, 1.0, prev, ray, rng);
+        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -180,12 +170,14 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, _live: u32, 
     let z = d.z;
     let refl_black = l.and(l.and(l.eq(refl.x, zero), l.eq(refl.y, zero)), l.eq(refl.z, zero));
     let sampled = l.and_not(l.and_not(l.not(wo_below), l.le(z, zero)), refl_black);
-    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
-    l.store(cosine_hemisphere_pdf(l, z), &mut c.pdf[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
+    // `Diffuse::sample`'s weight: the reflectance.
+    store3(l, refl, &mut c.next.weight, base);
+    l.store(cosine_hemisphere_pdf(l, z), &mut c.next.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
     let wi = c.v.world(l, base, d);
-    store3(l, wi, &mut c.next_dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next_origin, base);
+    store3(l, wi, &mut c.next.dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next.origin, base);
 }
 
 /// For the lanes of untransformed meshes: `World::interaction`'s geometric normal and

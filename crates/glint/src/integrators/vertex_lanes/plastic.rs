@@ -9,19 +9,18 @@
 //! [`Coating`]) is here; the rough coating's kernel (`rough_plastic`) adds its microfacet lobe
 //! and replaces the transmittance `1 - F` by its table.
 
-use super::columns::{NextEventColumns, VertexColumns};
+use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
 use super::lane_math::*;
 use super::smooth::fresnel_dielectric;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use super::{flag, get3, put3, Column, Column3};
 use crate::describe::PathSettings;
-use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::PlasticParams;
 use crate::math::lanes::{Lanes, MAX_LANES};
-use crate::math::{Frame, Ray, Rgb, INV_PI};
+use crate::math::{Frame, INV_PI};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
 
@@ -41,14 +40,8 @@ pub(crate) struct PlasticChunk {
     // In: the BSDF's lobe number and square sample.
     pub(super) u_lobe: Column,
     pub(super) u: [Column; 2],
-    // Out: the next ray, the sample's weight, density and kind (`sampled` 0 where the path
-    // ends, `delta` 1 where the coating's reflection was sampled).
-    pub(super) sampled: Column,
-    pub(super) delta: Column,
-    pub(super) weight: Column3,
-    pub(super) pdf: Column,
-    pub(super) next_origin: Column3,
-    pub(super) next_dir: Column3,
+    // Out: the sampled continuation.
+    pub(super) next: NextRayColumns,
 }
 
 impl PlasticChunk {
@@ -84,13 +77,7 @@ impl PlasticChunk {
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
-        if self.sampled[i] == 0.0 {
-            return;
-        }
-        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
-        let prev = PrevEvent { pdf: self.pdf[i], delta: self.delta[i] != 0.0, p: get3(&self.v.p, i) };
-        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
-        path.go_on(s, weight, 1.0, prev, ray, rng);
+        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -223,12 +210,12 @@ fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, _live: u32, 
     // `scatter` ends the path on a black weight too.
     let w_black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(kept, w_black);
-    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
-    l.store(l.select(mirror, one, zero), &mut c.delta[base..]);
-    store3(l, weight, &mut c.weight, base);
-    l.store(l.select(mirror, coat.ps, pdf_d), &mut c.pdf[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
+    l.store(l.select(mirror, one, zero), &mut c.next.delta[base..]);
+    store3(l, weight, &mut c.next.weight, base);
+    l.store(l.select(mirror, coat.ps, pdf_d), &mut c.next.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
     let wi = c.v.world(l, base, select3(l, mirror, reflected, d));
-    store3(l, wi, &mut c.next_dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next_origin, base);
+    store3(l, wi, &mut c.next.dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next.origin, base);
 }

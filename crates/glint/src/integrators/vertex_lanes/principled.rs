@@ -9,18 +9,17 @@
 //! sample's `sin_cos` and `powf`, GTR1's `ln`) are the scalar code's libm calls, made per
 //! lane ([`per_lane`]): the same call gives the same bits.
 
-use super::columns::{NextEventColumns, VertexColumns};
+use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
 use super::lane_math::*;
 use super::microfacet::{ggx_visible_normal_unit, per_lane};
 use super::{get3, put3, Column, Column3};
 use crate::describe::PathSettings;
-use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::Principled;
 use crate::math::lanes::{Lanes, MAX_LANES};
-use crate::math::{Ray, Rgb, INV_PI, PI};
+use crate::math::{INV_PI, PI};
 use crate::sampling::Sampler;
 
 /// Up to [`MAX_LANES`] principled vertices, one per lane.
@@ -50,13 +49,8 @@ pub(crate) struct PrincipledChunk {
     // In: the BSDF's random numbers.
     pub(super) u_lobe: Column,
     pub(super) u: [Column; 2],
-    // Out: the next ray (`sampled` 0 where the path ends), its weight, density and eta.
-    pub(super) sampled: Column,
-    pub(super) weight: Column3,
-    pub(super) pdf: Column,
-    pub(super) eta_out: Column,
-    pub(super) next_origin: Column3,
-    pub(super) next_dir: Column3,
+    // Out: the sampled continuation.
+    pub(super) next: NextRayColumns,
 }
 
 impl PrincipledChunk {
@@ -104,13 +98,7 @@ impl PrincipledChunk {
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
-        if self.sampled[i] == 0.0 {
-            return;
-        }
-        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
-        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.v.p, i) };
-        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
-        path.go_on(s, weight, self.eta_out[i], prev, ray, rng);
+        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -195,13 +183,13 @@ fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, _live:
     // `scatter` drops a black weight.
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(ok, black);
-    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
-    store3(l, weight, &mut c.weight, base);
-    l.store(pdf, &mut c.pdf[base..]);
-    l.store(l.select(pick_trans, fr.eta_ti, one), &mut c.eta_out[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
+    store3(l, weight, &mut c.next.weight, base);
+    l.store(pdf, &mut c.next.pdf[base..]);
+    l.store(l.select(pick_trans, fr.eta_ti, one), &mut c.next.eta[base..]);
     let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next_dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next_origin, base);
+    store3(l, wi_world, &mut c.next.dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
 }
 
 /// `Gtr1::sample(u)`: the clearcoat's normal.

@@ -16,7 +16,7 @@
 //! three times per vertex (at `wo`, towards the light and at the sampled direction), and only
 //! for the lanes that read the result.
 
-use super::columns::{NextEventColumns, VertexColumns};
+use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
 use super::lane_math::*;
 use super::microfacet::{per_lane, LaneMicrofacet, MicrofacetColumns};
 use super::plastic::{Coating, PlasticColumns};
@@ -25,13 +25,12 @@ use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use super::{get3, put3, Column, Column3};
 use crate::bsdf::Microfacet;
 use crate::describe::PathSettings;
-use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::{coating_transmittance, PlasticParams, TRANSMITTANCE_RES};
 use crate::math::lanes::{Lanes, MAX_LANES};
-use crate::math::{Frame, Ray, Rgb};
+use crate::math::Frame;
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
 
@@ -52,13 +51,8 @@ pub(crate) struct RoughPlasticChunk {
     // In: the BSDF's lobe number and square sample.
     pub(super) u_lobe: Column,
     pub(super) u: [Column; 2],
-    // Out: the next ray, the sample's weight and density (`sampled` 0 where the path ends;
-    // a rough plastic's samples are never delta).
-    pub(super) sampled: Column,
-    pub(super) weight: Column3,
-    pub(super) pdf: Column,
-    pub(super) next_origin: Column3,
-    pub(super) next_dir: Column3,
+    // Out: the sampled continuation.
+    pub(super) next: NextRayColumns,
 }
 
 impl RoughPlasticChunk {
@@ -97,13 +91,7 @@ impl RoughPlasticChunk {
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
         self.ne.finish(i, path, c);
-        if self.sampled[i] == 0.0 {
-            return;
-        }
-        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
-        let prev = PrevEvent { pdf: self.pdf[i], delta: false, p: get3(&self.v.p, i) };
-        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
-        path.go_on(s, weight, 1.0, prev, ray, rng);
+        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -185,11 +173,11 @@ fn rough_plastic_lanes<L: Lanes>(l: L, c: &mut RoughPlasticChunk, base: usize, l
     let weight = scale(l, value, l.div(one, pdf));
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(kept, black);
-    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
-    store3(l, weight, &mut c.weight, base);
-    l.store(pdf, &mut c.pdf[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
+    store3(l, weight, &mut c.next.weight, base);
+    l.store(pdf, &mut c.next.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
     let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next_dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next_origin, base);
+    store3(l, wi_world, &mut c.next.dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
 }

@@ -3,16 +3,15 @@
 //! `Bsdf::Dielectric` (the dielectric Fresnel term, reflection or refraction chosen by the
 //! lobe number): no light sample, no shadow ray, the next ray.
 
-use super::columns::VertexColumns;
+use super::columns::{NextRayColumns, VertexColumns};
 use super::lane_math::*;
 use super::{get3, put3, Column, Column3};
 use crate::describe::PathSettings;
-use crate::integrators::estimators::PrevEvent;
 use crate::integrators::path::PathState;
 use crate::integrators::Counters;
 use crate::materials::{Conductor, Dielectric};
 use crate::math::lanes::{Lanes, MAX_LANES};
-use crate::math::{Frame, Ray, Rgb};
+use crate::math::Frame;
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
 
@@ -39,12 +38,8 @@ pub(crate) struct SmoothChunk {
     pub(super) specular: Column3,
     pub(super) transmit: Column3,
     pub(super) u_lobe: Column,
-    // Out: the next ray, the sample's weight and eta (`sampled` 0 where the path ends).
-    pub(super) sampled: Column,
-    pub(super) weight: Column3,
-    pub(super) eta_out: Column,
-    pub(super) next_origin: Column3,
-    pub(super) next_dir: Column3,
+    // Out: the sampled continuation.
+    pub(super) next: NextRayColumns,
 }
 
 impl SmoothChunk {
@@ -86,13 +81,7 @@ impl SmoothChunk {
 
     /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
     pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, _c: &mut Counters) {
-        if self.sampled[i] == 0.0 {
-            return;
-        }
-        let weight = Rgb::from_array(get3(&self.weight, i).to_array());
-        let prev = PrevEvent { pdf: 1.0, delta: true, p: get3(&self.v.p, i) };
-        let ray = Ray::new(get3(&self.next_origin, i), get3(&self.next_dir, i));
-        path.go_on(s, weight, self.eta_out[i], prev, ray, rng);
+        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -134,12 +123,15 @@ fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize, _live: u32, _l
     }
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(sampled, black);
-    l.store(l.select(sampled, one, zero), &mut c.sampled[base..]);
-    store3(l, weight, &mut c.weight, base);
-    l.store(eta_out, &mut c.eta_out[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
+    // A delta sample of density 1.
+    l.store(one, &mut c.next.pdf[base..]);
+    l.store(one, &mut c.next.delta[base..]);
+    store3(l, weight, &mut c.next.weight, base);
+    l.store(eta_out, &mut c.next.eta[base..]);
     let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next_dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next_origin, base);
+    store3(l, wi_world, &mut c.next.dir, base);
+    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
 }
 
 /// `bsdf::DielectricFresnel` over lanes.

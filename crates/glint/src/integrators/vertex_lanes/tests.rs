@@ -133,8 +133,8 @@ fn outcome(c: &DiffuseChunk, i: usize) -> Outcome {
             bits1(c.ne.mis_weight[i]),
         )
     });
-    let next =
-        (c.sampled[i] != 0.0).then(|| (bits(get3(&c.next_origin, i)), bits(get3(&c.next_dir, i)), bits1(c.pdf[i])));
+    let next = (c.next.sampled[i] != 0.0)
+        .then(|| (bits(get3(&c.next.origin, i)), bits(get3(&c.next.dir, i)), bits1(c.next.pdf[i])));
     Outcome { shadow, next }
 }
 
@@ -384,12 +384,12 @@ fn check_smooth(isa: LaneIsa) {
         }
         chunk.run(isa, Strategy::Mis);
         for (i, w) in want.iter().enumerate() {
-            let got = (chunk.sampled[i] != 0.0).then(|| {
+            let got = (chunk.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.next_origin, i)),
-                    bits(get3(&chunk.next_dir, i)),
-                    bits(get3(&chunk.weight, i)),
-                    bits1(chunk.eta_out[i]),
+                    bits(get3(&chunk.next.origin, i)),
+                    bits(get3(&chunk.next.dir, i)),
+                    bits(get3(&chunk.next.weight, i)),
+                    bits1(chunk.next.eta[i]),
                 )
             });
             assert_eq!(&got, w, "{isa:?} lane {i}, round {round}");
@@ -605,12 +605,12 @@ fn check_rough(isa: LaneIsa) {
                     bits1(chunk.ne.mis_weight[i]),
                 )
             });
-            let got_next = (chunk.sampled[i] != 0.0).then(|| {
+            let got_next = (chunk.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.next_origin, i)),
-                    bits(get3(&chunk.next_dir, i)),
-                    bits1(chunk.pdf[i]),
-                    bits(get3(&chunk.weight, i)),
+                    bits(get3(&chunk.next.origin, i)),
+                    bits(get3(&chunk.next.dir, i)),
+                    bits1(chunk.next.pdf[i]),
+                    bits(get3(&chunk.next.weight, i)),
                 )
             });
             assert_eq!(&got_shadow, shadow, "{isa:?} lane {i}, round {round}, shadow: {m:?} {v:?}");
@@ -729,13 +729,13 @@ fn check_principled(isa: LaneIsa) {
                     bits1(c.ne.mis_weight[i]),
                 )
             });
-            let next = (c.sampled[i] != 0.0).then(|| {
+            let next = (c.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.next_origin, i)),
-                    bits(get3(&c.next_dir, i)),
-                    bits(get3(&c.weight, i)),
-                    bits1(c.pdf[i]),
-                    bits1(c.eta_out[i]),
+                    bits(get3(&c.next.origin, i)),
+                    bits(get3(&c.next.dir, i)),
+                    bits(get3(&c.next.weight, i)),
+                    bits1(c.next.pdf[i]),
+                    bits1(c.next.eta[i]),
                 )
             });
             assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {b:?}");
@@ -867,13 +867,13 @@ fn check_plastic(isa: LaneIsa) {
                     bits1(chunk.ne.mis_weight[i]),
                 )
             });
-            let next = (chunk.sampled[i] != 0.0).then(|| {
+            let next = (chunk.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.next_origin, i)),
-                    bits(get3(&chunk.next_dir, i)),
-                    bits1(chunk.pdf[i]),
-                    bits(get3(&chunk.weight, i)),
-                    chunk.delta[i] != 0.0,
+                    bits(get3(&chunk.next.origin, i)),
+                    bits(get3(&chunk.next.dir, i)),
+                    bits1(chunk.next.pdf[i]),
+                    bits(get3(&chunk.next.weight, i)),
+                    chunk.next.delta[i] != 0.0,
                 )
             });
             assert_eq!(
@@ -1001,13 +1001,13 @@ fn check_rough_dielectric(isa: LaneIsa) {
                     bits1(c.ne.mis_weight[i]),
                 )
             });
-            let next = (c.sampled[i] != 0.0).then(|| {
+            let next = (c.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.next_origin, i)),
-                    bits(get3(&c.next_dir, i)),
-                    bits(get3(&c.weight, i)),
-                    bits1(c.pdf[i]),
-                    bits1(c.eta_out[i]),
+                    bits(get3(&c.next.origin, i)),
+                    bits(get3(&c.next.dir, i)),
+                    bits(get3(&c.next.weight, i)),
+                    bits1(c.next.pdf[i]),
+                    bits1(c.next.eta[i]),
                 )
             });
             assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {b:?} u_lobe {}", c.u_lobe[i]);
@@ -1130,12 +1130,12 @@ fn check_rough_plastic(isa: LaneIsa) {
                     bits1(c.ne.mis_weight[i]),
                 )
             });
-            let next = (c.sampled[i] != 0.0).then(|| {
+            let next = (c.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.next_origin, i)),
-                    bits(get3(&c.next_dir, i)),
-                    bits(get3(&c.weight, i)),
-                    bits1(c.pdf[i]),
+                    bits(get3(&c.next.origin, i)),
+                    bits(get3(&c.next.dir, i)),
+                    bits(get3(&c.next.weight, i)),
+                    bits1(c.next.pdf[i]),
                     // A rough plastic's samples keep the index (`go_on`'s eta of 1).
                     1.0f32.to_bits(),
                 )
