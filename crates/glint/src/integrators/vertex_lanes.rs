@@ -53,8 +53,8 @@ macro_rules! lane_kernel {
                 #[inline(always)]
                 fn every_vector<L: Lanes>(l: L, c: &mut $chunk, light_only: bool) {
                     let mut base = 0;
-                    while base < c.len {
-                        let live = (1u32 << (c.len - base).min(L::N)) - 1;
+                    while base < c.shared.len {
+                        let live = (1u32 << (c.shared.len - base).min(L::N)) - 1;
                         $lanes(l, c, base, live, light_only);
                         base += L::N;
                     }
@@ -245,22 +245,22 @@ trait Chunk {
     fn clear(&mut self);
 }
 
-/// The chunks have the same bookkeeping: `len`, `path`, `run` and `finish`.
+/// The chunks keep their bookkeeping in `SharedColumns` and their kernel in `run`.
 macro_rules! chunks {
     ($($chunk:ty),+) => {$(
         impl Chunk for $chunk {
             fn waiting(&self) -> usize {
-                self.len
+                self.shared.len
             }
             fn kernel(&mut self, isa: LaneIsa, strategy: Strategy) {
                 self.run(isa, strategy);
             }
             fn finish_lane(&self, lane: usize, paths: &mut [PathState], samples: &mut [CameraSample], s: &PathSettings, c: &mut Counters) {
-                let i = self.path[lane] as usize;
-                self.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
+                let i = self.shared.path[lane] as usize;
+                self.shared.finish(lane, &mut paths[i], s, &mut samples[i].sampler, c);
             }
             fn clear(&mut self) {
-                self.len = 0;
+                self.shared.len = 0;
             }
         }
     )+};
@@ -343,7 +343,7 @@ impl LaneStepper {
             }
             let light = light_sample(s, scene, p, rng);
             self.diffuse.push_mesh(index, path, &mesh_hit, p, light, rng);
-            if self.diffuse.len >= lanes {
+            if self.diffuse.shared.len >= lanes {
                 flush_chunk(&mut self.diffuse, isa, s, paths, samples, c);
             }
             return;
@@ -362,15 +362,15 @@ impl LaneStepper {
             Bsdf::Diffuse(d) => {
                 let light = light_sample(s, scene, si.p, rng);
                 self.diffuse.push(index, path, &si, &frame, d.reflectance, light, rng);
-                (Class::Diffuse, self.diffuse.len)
+                (Class::Diffuse, self.diffuse.shared.len)
             }
             Bsdf::Conductor(m) => {
                 self.smooth.push(index, path, &si, &frame, Smooth::Conductor(*m), rng);
-                (Class::Smooth, self.smooth.len)
+                (Class::Smooth, self.smooth.shared.len)
             }
             Bsdf::Dielectric(d) => {
                 self.smooth.push(index, path, &si, &frame, Smooth::Dielectric(*d), rng);
-                (Class::Smooth, self.smooth.len)
+                (Class::Smooth, self.smooth.shared.len)
             }
             // The smooth kernel's coating transmits 1 - F: a smooth coating with a table (only
             // a hand-built plastic has one) steps through `scatter` below.
@@ -379,28 +379,28 @@ impl LaneStepper {
                 match &p.dist {
                     None => {
                         self.plastic.push(index, path, &si, &frame, p, light, rng);
-                        (Class::Plastic, self.plastic.len)
+                        (Class::Plastic, self.plastic.shared.len)
                     }
                     Some(dist) => {
                         self.rough_plastic.push(index, path, &si, &frame, p, dist, light, rng);
-                        (Class::RoughPlastic, self.rough_plastic.len)
+                        (Class::RoughPlastic, self.rough_plastic.shared.len)
                     }
                 }
             }
             Bsdf::RoughConductor(m) => {
                 let light = light_sample(s, scene, si.p, rng);
                 self.rough.push(index, path, &si, &frame, m, light, rng);
-                (Class::Rough, self.rough.len)
+                (Class::Rough, self.rough.shared.len)
             }
             Bsdf::RoughDielectric(d) => {
                 let light = light_sample(s, scene, si.p, rng);
                 self.rough_dielectric.push(index, path, &si, &frame, d, light, rng);
-                (Class::RoughDielectric, self.rough_dielectric.len)
+                (Class::RoughDielectric, self.rough_dielectric.shared.len)
             }
             Bsdf::Principled(b) => {
                 let light = light_sample(s, scene, si.p, rng);
                 self.principled.push(index, path, &si, &frame, b, light, rng);
-                (Class::Principled, self.principled.len)
+                (Class::Principled, self.principled.shared.len)
             }
             // Not in lanes yet.
             Bsdf::Plastic(_)

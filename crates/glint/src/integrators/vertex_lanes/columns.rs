@@ -216,3 +216,52 @@ impl NextRayColumns {
         path.go_on(s, weight, self.eta[i], prev, ray, rng);
     }
 }
+
+/// What every chunk holds besides its BSDF's parameters: which path each lane is, its vertex,
+/// throughput, light sample and the BSDF's random numbers in, the continuation out.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct SharedColumns {
+    pub len: usize,
+    /// Which path each lane is (the caller's index).
+    pub path: [u32; MAX_LANES],
+    pub v: VertexColumns,
+    pub throughput: Column3,
+    pub ne: NextEventColumns,
+    pub u_lobe: Column,
+    pub u: [Column; 2],
+    pub next: NextRayColumns,
+}
+
+impl SharedColumns {
+    /// Adds path `index`'s vertex at `p` as the next lane (its frame is the caller's to put)
+    /// with the light sample the caller drew, then draws the BSDF's random numbers from `rng`
+    /// as `PathState::scatter` draws them after the light sample: the lobe number, then the
+    /// square. Returns the lane.
+    pub fn push(
+        &mut self,
+        index: u32,
+        path: &PathState,
+        p: Vec3,
+        light: Option<(LightSample, f32)>,
+        rng: &mut Sampler,
+    ) -> usize {
+        let i = self.len;
+        self.len += 1;
+        self.path[i] = index;
+        self.v.put_ray(i, path.ray.dir, p);
+        put3(&mut self.throughput, i, path.throughput().to_array());
+        self.ne.put(i, light);
+        self.u_lobe[i] = rng.next_f32();
+        let u = rng.next_2d();
+        self.u[0][i] = u[0];
+        self.u[1][i] = u[1];
+        i
+    }
+
+    /// Lane `i`'s shadow ray and continuation into its path, as the end of
+    /// `PathState::scatter` does.
+    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
+        self.ne.finish(i, path, c);
+        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
+    }
+}

@@ -3,15 +3,13 @@
 //! shadow ray, the cosine sample and the next ray (`diffuse_lanes`), as
 //! `PathState::scatter` computes them for `Bsdf::Diffuse`.
 
-use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
+use super::columns::SharedColumns;
 use super::lane_math::*;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use super::{flag, get3, put3, Column, Column3, MeshHit};
-use crate::describe::PathSettings;
+use super::{flag, put3, Column, Column3, MeshHit};
 use crate::integrators::path::PathState;
-use crate::integrators::Counters;
 use crate::lights::LightSample;
-use crate::math::lanes::{Lanes, MAX_LANES};
+use crate::math::lanes::Lanes;
 use crate::math::{Frame, Rgb, Vec3, INV_PI};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -20,16 +18,10 @@ use crate::world::SurfaceInteraction;
 /// the kernel leaves. Flags are 1.0 (true) or 0.0.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct DiffuseChunk {
-    pub len: usize,
-    /// Which path each lane is (the caller's index).
-    pub path: [u32; MAX_LANES],
-    pub(super) v: VertexColumns,
+    /// The vertex, its light sample and random numbers, and the continuation.
+    pub(super) shared: SharedColumns,
+    /// In: the reflectance.
     pub(super) reflectance: Column3,
-    pub(super) throughput: Column3,
-    /// The light sample in, the shadow ray out.
-    pub(super) ne: NextEventColumns,
-    // In: the BSDF's square sample.
-    pub(super) u: [Column; 2],
     // In, for lanes whose interaction the kernel computes (`from_mesh` 1): the hit triangle of
     // an untransformed mesh, its barycentrics, vertex normals and uvs where the mesh has them,
     // and the instance's and material's flags. The kernel then writes `ng`, `n`, `s`, `t`.
@@ -42,8 +34,6 @@ pub(crate) struct DiffuseChunk {
     pub(super) uvs: [[Column; 2]; 3],
     pub(super) flip_normals: Column,
     pub(super) two_sided: Column,
-    // Out: the sampled continuation.
-    pub(super) next: NextRayColumns,
 }
 
 impl DiffuseChunk {
@@ -63,7 +53,7 @@ impl DiffuseChunk {
     ) {
         let i = self.push_common(path_index, path, si.p, reflectance, light, rng);
         self.from_mesh[i] = 0.0;
-        self.v.put_frame(i, si.ng, frame);
+        self.shared.v.put_frame(i, si.ng, frame);
     }
 
     /// Adds a path's vertex on an untransformed mesh as the next lane, its interaction and
@@ -97,10 +87,8 @@ impl DiffuseChunk {
         self.two_sided[i] = flag(hit.two_sided);
     }
 
-    /// The lane's path, ray, hit point, reflectance and throughput, its light sample, and the
-    /// BSDF's random numbers drawn from `rng` as `PathState::scatter` draws them after the
-    /// light sample: the lobe number (unused by a Lambertian BSDF, drawn all the same) and
-    /// the square. Returns the lane.
+    /// `SharedColumns::push` and the reflectance (a Lambertian BSDF reads no lobe number, drawn
+    /// all the same). Returns the lane.
     fn push_common(
         &mut self,
         path_index: u32,
@@ -110,24 +98,9 @@ impl DiffuseChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) -> usize {
-        let i = self.len;
-        self.len += 1;
-        self.path[i] = path_index;
-        self.v.put_ray(i, path.ray.dir, p);
+        let i = self.shared.push(path_index, path, p, light, rng);
         put3(&mut self.reflectance, i, reflectance.to_array());
-        put3(&mut self.throughput, i, path.throughput().to_array());
-        self.ne.put(i, light);
-        let _u_lobe = rng.next_f32();
-        let u = rng.next_2d();
-        self.u[0][i] = u[0];
-        self.u[1][i] = u[1];
         i
-    }
-
-    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
-        self.ne.finish(i, path, c);
-        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -140,17 +113,17 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, _live: u32, 
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let inv_pi = l.splat(INV_PI);
-    let dir = load3(l, &c.v.dir, base);
-    let n = load3(l, &c.v.n, base);
+    let dir = load3(l, &c.shared.v.dir, base);
+    let n = load3(l, &c.shared.v.n, base);
     let refl = load3(l, &c.reflectance, base);
-    let thr = load3(l, &c.throughput, base);
+    let thr = load3(l, &c.shared.throughput, base);
     // `frame.to_local(-ray.dir).z`: the Lambertian BSDF reads only the normal component.
     let wo_z = dot(l, V3 { x: l.neg(dir.x), y: l.neg(dir.y), z: l.neg(dir.z) }, n);
     let wo_below = l.le(wo_z, zero);
 
     // Next-event estimation: `Diffuse::eval` and `pdf` towards the light, then what
     // `NextEventColumns::lanes` makes of them.
-    let light_wi = load3(l, &c.ne.light_wi, base);
+    let light_wi = load3(l, &c.shared.ne.light_wi, base);
     let wi_z = dot(l, light_wi, n);
     let black = l.or(wo_below, l.le(wi_z, zero));
     let k = l.mul(inv_pi, wi_z);
@@ -161,23 +134,23 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, _live: u32, 
     };
     // `cosine_hemisphere_pdf(wi.z)`, where `wi.z` is above 0 or NaN.
     let bsdf_pdf = l.select(black, zero, cosine_hemisphere_pdf(l, wi_z));
-    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+    c.shared.ne.lanes(l, base, &c.shared.v, thr, f, bsdf_pdf, light_only);
 
     // `Diffuse::sample`: `cosine_hemisphere(u)`.
-    let u0 = l.load(&c.u[0][base..]);
-    let u1 = l.load(&c.u[1][base..]);
+    let u0 = l.load(&c.shared.u[0][base..]);
+    let u1 = l.load(&c.shared.u[1][base..]);
     let d = cosine_hemisphere(l, u0, u1);
     let z = d.z;
     let refl_black = l.and(l.and(l.eq(refl.x, zero), l.eq(refl.y, zero)), l.eq(refl.z, zero));
     let sampled = l.and_not(l.and_not(l.not(wo_below), l.le(z, zero)), refl_black);
-    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
     // `Diffuse::sample`'s weight: the reflectance.
-    store3(l, refl, &mut c.next.weight, base);
-    l.store(cosine_hemisphere_pdf(l, z), &mut c.next.pdf[base..]);
+    store3(l, refl, &mut c.shared.next.weight, base);
+    l.store(cosine_hemisphere_pdf(l, z), &mut c.shared.next.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi = c.v.world(l, base, d);
-    store3(l, wi, &mut c.next.dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next.origin, base);
+    let wi = c.shared.v.world(l, base, d);
+    store3(l, wi, &mut c.shared.next.dir, base);
+    store3(l, c.shared.v.spawn_origin(l, base, wi), &mut c.shared.next.origin, base);
 }
 
 /// For the lanes of untransformed meshes: `World::interaction`'s geometric normal and
@@ -232,11 +205,11 @@ fn mesh_frames<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize) {
     let s = select3(l, tangent_ok, s_unit, basis_s);
     let t = select3(l, tangent_ok, cross(l, n_shading, s_unit), basis_t);
     // `shading`: a two-sided material's frame faces the viewer (`-ray.dir`).
-    let dir = load3(l, &c.v.dir, base);
+    let dir = load3(l, &c.shared.v.dir, base);
     let facing_away = l.lt(dot(l, n_shading, neg3(l, dir)), zero);
     let turn = l.and(yes(&c.two_sided), facing_away);
     let n = select3(l, turn, neg3(l, n_shading), n_shading);
-    let v = &mut c.v;
+    let v = &mut c.shared.v;
     let keep = |new: V3<L::F>, col: &Column3| select3(l, from_mesh, new, load3(l, col, base));
     let (ng, n, s, t) = (keep(ng, &v.ng), keep(n, &v.n), keep(s, &v.s), keep(t, &v.t));
     store3(l, ng, &mut v.ng, base);

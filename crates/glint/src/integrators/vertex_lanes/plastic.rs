@@ -9,17 +9,15 @@
 //! [`Coating`]) is here; the rough coating's kernel (`rough_plastic`) adds its microfacet lobe
 //! and replaces the transmittance `1 - F` by its table.
 
-use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
+use super::columns::SharedColumns;
 use super::lane_math::*;
 use super::smooth::fresnel_dielectric;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use super::{flag, get3, put3, Column, Column3};
-use crate::describe::PathSettings;
+use super::{flag, put3, Column, Column3};
 use crate::integrators::path::PathState;
-use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::PlasticParams;
-use crate::math::lanes::{Lanes, MAX_LANES};
+use crate::math::lanes::Lanes;
 use crate::math::{Frame, INV_PI};
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -28,20 +26,10 @@ use crate::world::SurfaceInteraction;
 /// gathered, and what the kernel leaves. Flags are 1.0 (true) or 0.0.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct PlasticChunk {
-    pub len: usize,
-    /// Which path each lane is (the caller's index).
-    pub path: [u32; MAX_LANES],
-    pub(super) v: VertexColumns,
-    pub(super) throughput: Column3,
+    /// The vertex, its light sample and random numbers, and the continuation.
+    pub(super) shared: SharedColumns,
     /// In: the BSDF.
     pub(super) bsdf: PlasticColumns,
-    /// The light sample in, the shadow ray out.
-    pub(super) ne: NextEventColumns,
-    // In: the BSDF's lobe number and square sample.
-    pub(super) u_lobe: Column,
-    pub(super) u: [Column; 2],
-    // Out: the sampled continuation.
-    pub(super) next: NextRayColumns,
 }
 
 impl PlasticChunk {
@@ -60,24 +48,9 @@ impl PlasticChunk {
         rng: &mut Sampler,
     ) {
         debug_assert!(bsdf.dist.is_none(), "rough plastics wait in `RoughPlasticChunk`");
-        let i = self.len;
-        self.len += 1;
-        self.path[i] = path_index;
-        self.v.put_ray(i, path.ray.dir, si.p);
-        self.v.put_frame(i, si.ng, frame);
-        put3(&mut self.throughput, i, path.throughput().to_array());
+        let i = self.shared.push(path_index, path, si.p, light, rng);
+        self.shared.v.put_frame(i, si.ng, frame);
         self.bsdf.put(i, bsdf);
-        self.ne.put(i, light);
-        self.u_lobe[i] = rng.next_f32();
-        let u = rng.next_2d();
-        self.u[0][i] = u[0];
-        self.u[1][i] = u[1];
-    }
-
-    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
-        self.ne.finish(i, path, c);
-        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -178,29 +151,29 @@ impl<F: Copy> Coating<F> {
 #[inline(always)]
 fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, _live: u32, light_only: bool) {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
-    let wo = c.v.wo_local(l, base);
-    let n = load3(l, &c.v.n, base);
-    let thr = load3(l, &c.throughput, base);
+    let wo = c.shared.v.wo_local(l, base);
+    let n = load3(l, &c.shared.v.n, base);
+    let thr = load3(l, &c.shared.throughput, base);
     let coat = Coating::new(l, &c.bsdf, base, wo.z);
     // `eval`, `pdf` and `sample` give nothing below the surface (NaN goes on).
     let wo_below = l.le(wo.z, zero);
 
     // Next-event estimation: `eval` and `pdf` towards the light (the diffuse lobe's only),
     // then what `NextEventColumns::lanes` makes of them. `frame.to_local(ls.wi).z`.
-    let wi_z = dot(l, load3(l, &c.ne.light_wi, base), n);
+    let wi_z = dot(l, load3(l, &c.shared.ne.light_wi, base), n);
     let black = l.or(wo_below, l.le(wi_z, zero));
     let f = select3(l, black, V3 { x: zero, y: zero, z: zero }, coat.diffuse_eval(l, wi_z));
     // `(1 - ps) * cosine_hemisphere_pdf(wi.z)`, where `wi.z` is above 0 or NaN.
     let bsdf_pdf = l.select(black, zero, l.mul(l.sub(one, coat.ps), cosine_hemisphere_pdf(l, wi_z)));
-    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+    c.shared.ne.lanes(l, base, &c.shared.v, thr, f, bsdf_pdf, light_only);
 
     // `sample`: the coating's reflection where `u_lobe < ps`, weighted `specular * (F / ps)`
     // with density `ps`; else the cosine-sampled base, weighted `diffuse_eval / pdf` with
     // density `(1 - ps) * cosine_hemisphere_pdf(wi.z)`, none where `wi.z <= 0`.
-    let mirror = l.lt(l.load(&c.u_lobe[base..]), coat.ps);
+    let mirror = l.lt(l.load(&c.shared.u_lobe[base..]), coat.ps);
     let reflected = V3 { x: l.neg(wo.x), y: l.neg(wo.y), z: wo.z };
     let w_mirror = scale(l, load3(l, &c.bsdf.specular, base), l.div(coat.fresnel_o, coat.ps));
-    let d = cosine_hemisphere(l, l.load(&c.u[0][base..]), l.load(&c.u[1][base..]));
+    let d = cosine_hemisphere(l, l.load(&c.shared.u[0][base..]), l.load(&c.shared.u[1][base..]));
     // `d.z` is never -0.0 (a square root of a `max` with +0).
     let pdf_d = l.mul(l.sub(one, coat.ps), cosine_hemisphere_pdf(l, d.z));
     let w_diffuse = scale(l, coat.diffuse_eval(l, d.z), l.div(one, pdf_d));
@@ -210,12 +183,12 @@ fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, _live: u32, 
     // `scatter` ends the path on a black weight too.
     let w_black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(kept, w_black);
-    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
-    l.store(l.select(mirror, one, zero), &mut c.next.delta[base..]);
-    store3(l, weight, &mut c.next.weight, base);
-    l.store(l.select(mirror, coat.ps, pdf_d), &mut c.next.pdf[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
+    l.store(l.select(mirror, one, zero), &mut c.shared.next.delta[base..]);
+    store3(l, weight, &mut c.shared.next.weight, base);
+    l.store(l.select(mirror, coat.ps, pdf_d), &mut c.shared.next.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi = c.v.world(l, base, select3(l, mirror, reflected, d));
-    store3(l, wi, &mut c.next.dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi), &mut c.next.origin, base);
+    let wi = c.shared.v.world(l, base, select3(l, mirror, reflected, d));
+    store3(l, wi, &mut c.shared.next.dir, base);
+    store3(l, c.shared.v.spawn_origin(l, base, wi), &mut c.shared.next.origin, base);
 }

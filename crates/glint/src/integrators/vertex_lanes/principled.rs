@@ -9,27 +9,22 @@
 //! sample's `sin_cos` and `powf`, GTR1's `ln`) are the scalar code's libm calls, made per
 //! lane ([`per_lane`]): the same call gives the same bits.
 
-use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
+use super::columns::SharedColumns;
 use super::lane_math::*;
 use super::microfacet::{ggx_visible_normal_unit, per_lane};
-use super::{get3, put3, Column, Column3};
-use crate::describe::PathSettings;
+use super::{put3, Column, Column3};
 use crate::integrators::path::PathState;
-use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::Principled;
-use crate::math::lanes::{Lanes, MAX_LANES};
+use crate::math::lanes::Lanes;
 use crate::math::{INV_PI, PI};
 use crate::sampling::Sampler;
 
 /// Up to [`MAX_LANES`] principled vertices, one per lane.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct PrincipledChunk {
-    pub len: usize,
-    pub path: [u32; MAX_LANES],
-    pub(super) v: VertexColumns,
-    pub(super) ne: NextEventColumns,
-    pub(super) throughput: Column3,
+    /// The vertex, its light sample and random numbers, and the continuation.
+    pub(super) shared: SharedColumns,
     // In: the BSDF's parameters.
     pub(super) base_color: Column3,
     pub(super) roughness: Column,
@@ -46,11 +41,6 @@ pub(crate) struct PrincipledChunk {
     pub(super) clearcoat_alpha: Column,
     /// The sampling rates: diffuse, specular, clearcoat.
     pub(super) rates: Column3,
-    // In: the BSDF's random numbers.
-    pub(super) u_lobe: Column,
-    pub(super) u: [Column; 2],
-    // Out: the sampled continuation.
-    pub(super) next: NextRayColumns,
 }
 
 impl PrincipledChunk {
@@ -68,13 +58,8 @@ impl PrincipledChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.len;
-        self.len += 1;
-        self.path[i] = path_index;
-        self.v.put_ray(i, path.ray.dir, si.p);
-        self.v.put_frame(i, si.ng, frame);
-        self.ne.put(i, light);
-        put3(&mut self.throughput, i, path.throughput().to_array());
+        let i = self.shared.push(path_index, path, si.p, light, rng);
+        self.shared.v.put_frame(i, si.ng, frame);
         put3(&mut self.base_color, i, b.base_color.to_array());
         self.roughness[i] = b.roughness;
         self.alpha_x[i] = b.dist.alpha_x;
@@ -89,16 +74,6 @@ impl PrincipledChunk {
         self.clearcoat[i] = b.clearcoat;
         self.clearcoat_alpha[i] = b.clearcoat_alpha;
         put3(&mut self.rates, i, [b.rates.diffuse, b.rates.specular, b.rates.clearcoat]);
-        self.u_lobe[i] = rng.next_f32();
-        let u = rng.next_2d();
-        self.u[0][i] = u[0];
-        self.u[1][i] = u[1];
-    }
-
-    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
-        self.ne.finish(i, path, c);
-        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -118,17 +93,18 @@ fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, _live:
     let zero = l.splat(0.0);
     let one = l.splat(1.0);
     let b = Params::load(l, c, base);
-    let wo = c.v.wo_local(l, base);
+    let wo = c.shared.v.wo_local(l, base);
 
     // Next-event estimation.
-    let light_wi = c.v.local(l, base, load3(l, &c.ne.light_wi, base));
+    let light_wi = c.shared.v.local(l, base, load3(l, &c.shared.ne.light_wi, base));
     let f = b.eval(l, wo, light_wi);
     let bsdf_pdf = b.pdf(l, wo, light_wi);
-    let throughput = load3(l, &c.throughput, base);
-    c.ne.lanes(l, base, &c.v, throughput, f, bsdf_pdf, light_only);
+    let throughput = load3(l, &c.shared.throughput, base);
+    c.shared.ne.lanes(l, base, &c.shared.v, throughput, f, bsdf_pdf, light_only);
 
     // `Principled::sample`.
-    let (u_lobe, u0, u1) = (l.load(&c.u_lobe[base..]), l.load(&c.u[0][base..]), l.load(&c.u[1][base..]));
+    let (u_lobe, u0, u1) =
+        (l.load(&c.shared.u_lobe[base..]), l.load(&c.shared.u[0][base..]), l.load(&c.shared.u[1][base..]));
     let cos_o = wo.z;
     let front = l.gt(cos_o, zero);
     let (_, bsdf) = b.weights(l);
@@ -183,13 +159,13 @@ fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, _live:
     // `scatter` drops a black weight.
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(ok, black);
-    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
-    store3(l, weight, &mut c.next.weight, base);
-    l.store(pdf, &mut c.next.pdf[base..]);
-    l.store(l.select(pick_trans, fr.eta_ti, one), &mut c.next.eta[base..]);
-    let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next.dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
+    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
+    store3(l, weight, &mut c.shared.next.weight, base);
+    l.store(pdf, &mut c.shared.next.pdf[base..]);
+    l.store(l.select(pick_trans, fr.eta_ti, one), &mut c.shared.next.eta[base..]);
+    let wi_world = c.shared.v.world(l, base, wi);
+    store3(l, wi_world, &mut c.shared.next.dir, base);
+    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }
 
 /// `Gtr1::sample(u)`: the clearcoat's normal.

@@ -3,17 +3,15 @@
 //! the shadow ray, then a visible normal (`microfacet`), the reflected direction, its value
 //! and density (`BsdfSample::non_delta`'s rules) and the next ray.
 
-use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
+use super::columns::SharedColumns;
 use super::lane_math::*;
 use super::microfacet::{LaneMicrofacet, MicrofacetColumns};
 use super::smooth::fresnel_conductor;
-use super::{get3, put3, Column, Column3};
-use crate::describe::PathSettings;
+use super::{put3, Column3};
 use crate::integrators::path::PathState;
-use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::RoughConductor;
-use crate::math::lanes::{Lanes, MAX_LANES};
+use crate::math::lanes::Lanes;
 use crate::math::Frame;
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -21,19 +19,13 @@ use crate::world::SurfaceInteraction;
 /// Up to [`MAX_LANES`] rough conductor vertices, one per lane.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct RoughChunk {
-    pub len: usize,
-    pub path: [u32; MAX_LANES],
-    pub(super) v: VertexColumns,
-    // In: the BSDF, the throughput, the light sample and the BSDF's square sample.
+    /// The vertex, its light sample and random numbers, and the continuation.
+    pub(super) shared: SharedColumns,
+    // In: the BSDF.
     pub(super) dist: MicrofacetColumns,
     pub(super) eta: Column3,
     pub(super) k: Column3,
     pub(super) specular: Column3,
-    pub(super) throughput: Column3,
-    pub(super) ne: NextEventColumns,
-    pub(super) u: [Column; 2],
-    // Out: the sampled continuation.
-    pub(super) next: NextRayColumns,
 }
 
 impl RoughChunk {
@@ -51,27 +43,12 @@ impl RoughChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.len;
-        self.len += 1;
-        self.path[i] = path_index;
-        self.v.put_ray(i, path.ray.dir, si.p);
-        self.v.put_frame(i, si.ng, frame);
+        let i = self.shared.push(path_index, path, si.p, light, rng);
+        self.shared.v.put_frame(i, si.ng, frame);
         self.dist.put(i, &m.dist);
         put3(&mut self.eta, i, m.eta.to_array());
         put3(&mut self.k, i, m.k.to_array());
         put3(&mut self.specular, i, m.specular.to_array());
-        put3(&mut self.throughput, i, path.throughput().to_array());
-        self.ne.put(i, light);
-        let _u_lobe = rng.next_f32();
-        let u = rng.next_2d();
-        self.u[0][i] = u[0];
-        self.u[1][i] = u[1];
-    }
-
-    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
-        self.ne.finish(i, path, c);
-        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -115,19 +92,19 @@ fn rough_lanes<L: Lanes>(l: L, c: &mut RoughChunk, base: usize, live: u32, light
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
     let dist = c.dist.lanes(l, base);
     let (eta, k, spec) = (load3(l, &c.eta, base), load3(l, &c.k, base), load3(l, &c.specular, base));
-    let wo = c.v.wo_local(l, base);
+    let wo = c.shared.v.wo_local(l, base);
 
     // Next-event estimation: the BSDF towards the light, then what `NextEventColumns::lanes`
     // makes of it.
-    let thr = load3(l, &c.throughput, base);
-    let light_wi = c.v.local(l, base, load3(l, &c.ne.light_wi, base));
+    let thr = load3(l, &c.shared.throughput, base);
+    let light_wi = c.shared.v.local(l, base, load3(l, &c.shared.ne.light_wi, base));
     let (f, bsdf_pdf) = eval_pdf(l, &dist, eta, k, spec, wo, light_wi);
-    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+    c.shared.ne.lanes(l, base, &c.shared.v, thr, f, bsdf_pdf, light_only);
 
     // `RoughConductor::sample`: nothing where `wo` is below the surface, else a visible
     // normal and the direction it reflects `wo` to.
     let above = l.not(l.le(wo.z, zero));
-    let u = [l.load(&c.u[0][base..]), l.load(&c.u[1][base..])];
+    let u = [l.load(&c.shared.u[0][base..]), l.load(&c.shared.u[1][base..])];
     let h = dist.sample_wm(l, wo, u, live & l.bits(above));
     // `(h * (2.0 * wo.dot(h)) - wo).normalize()`.
     let wi = normalize(l, sub3(l, scale(l, h, l.mul(l.splat(2.0), dot(l, wo, h))), wo));
@@ -138,11 +115,11 @@ fn rough_lanes<L: Lanes>(l: L, c: &mut RoughChunk, base: usize, live: u32, light
     let weight = scale(l, value, l.div(one, pdf));
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(kept, black);
-    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
-    store3(l, weight, &mut c.next.weight, base);
-    l.store(pdf, &mut c.next.pdf[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
+    store3(l, weight, &mut c.shared.next.weight, base);
+    l.store(pdf, &mut c.shared.next.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next.dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
+    let wi_world = c.shared.v.world(l, base, wi);
+    store3(l, wi_world, &mut c.shared.next.dir, base);
+    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }

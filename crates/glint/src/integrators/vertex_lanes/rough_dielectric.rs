@@ -9,18 +9,16 @@
 //! scalar function's, called once per vertex at `push`; the microfacet's libm calls are
 //! `microfacet`'s per-lane ones. Everything else runs in the vector operations.
 
-use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
+use super::columns::SharedColumns;
 use super::lane_math::*;
 use super::microfacet::{LaneMicrofacet, MicrofacetColumns};
 use super::smooth::fresnel_dielectric;
-use super::{get3, put3, Column, Column3};
+use super::{put3, Column, Column3};
 use crate::bsdf::lobe_weight;
-use crate::describe::PathSettings;
 use crate::integrators::path::PathState;
-use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::RoughDielectric;
-use crate::math::lanes::{Lanes, MAX_LANES};
+use crate::math::lanes::Lanes;
 use crate::math::Frame;
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -28,23 +26,15 @@ use crate::world::SurfaceInteraction;
 /// Up to [`MAX_LANES`] rough dielectric vertices, one per lane.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct RoughDielectricChunk {
-    pub len: usize,
-    pub path: [u32; MAX_LANES],
-    pub(super) v: VertexColumns,
-    // In: the BSDF (with its tints' lobe weights), the throughput, the light sample and the
-    // BSDF's random numbers.
+    /// The vertex, its light sample and random numbers, and the continuation.
+    pub(super) shared: SharedColumns,
+    // In: the BSDF, with its tints' lobe weights.
     pub(super) dist: MicrofacetColumns,
     pub(super) eta: Column,
     pub(super) reflect: Column3,
     pub(super) transmit: Column3,
     pub(super) reflect_weight: Column,
     pub(super) transmit_weight: Column,
-    pub(super) throughput: Column3,
-    pub(super) ne: NextEventColumns,
-    pub(super) u_lobe: Column,
-    pub(super) u: [Column; 2],
-    // Out: the sampled continuation.
-    pub(super) next: NextRayColumns,
 }
 
 impl RoughDielectricChunk {
@@ -62,29 +52,14 @@ impl RoughDielectricChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.len;
-        self.len += 1;
-        self.path[i] = path_index;
-        self.v.put_ray(i, path.ray.dir, si.p);
-        self.v.put_frame(i, si.ng, frame);
+        let i = self.shared.push(path_index, path, si.p, light, rng);
+        self.shared.v.put_frame(i, si.ng, frame);
         self.dist.put(i, &b.dist);
         self.eta[i] = b.eta;
         put3(&mut self.reflect, i, b.reflect.to_array());
         put3(&mut self.transmit, i, b.transmit.to_array());
         self.reflect_weight[i] = lobe_weight(b.reflect);
         self.transmit_weight[i] = lobe_weight(b.transmit);
-        put3(&mut self.throughput, i, path.throughput().to_array());
-        self.ne.put(i, light);
-        self.u_lobe[i] = rng.next_f32();
-        let u = rng.next_2d();
-        self.u[0][i] = u[0];
-        self.u[1][i] = u[1];
-    }
-
-    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
-        self.ne.finish(i, path, c);
-        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -173,20 +148,20 @@ impl<L: Lanes> Glass<L> {
 fn rough_dielectric_lanes<L: Lanes>(l: L, c: &mut RoughDielectricChunk, base: usize, live: u32, light_only: bool) {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
     let g = Glass::load(l, c, base);
-    let wo = c.v.wo_local(l, base);
+    let wo = c.shared.v.wo_local(l, base);
 
     // Next-event estimation: the BSDF towards the light, then what `NextEventColumns::lanes`
     // makes of it.
-    let thr = load3(l, &c.throughput, base);
-    let light_wi = c.v.local(l, base, load3(l, &c.ne.light_wi, base));
+    let thr = load3(l, &c.shared.throughput, base);
+    let light_wi = c.shared.v.local(l, base, load3(l, &c.shared.ne.light_wi, base));
     let (f, bsdf_pdf) = g.eval_pdf(l, wo, light_wi);
-    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+    c.shared.ne.lanes(l, base, &c.shared.v, thr, f, bsdf_pdf, light_only);
 
     // `sample_rough_dielectric`: nothing where `wo.z == 0`, else a visible normal (seen from
     // either side), the Fresnel term there and the lobe number's choice.
     let facing = l.ne(wo.z, zero);
-    let u_lobe = l.load(&c.u_lobe[base..]);
-    let u = [l.load(&c.u[0][base..]), l.load(&c.u[1][base..])];
+    let u_lobe = l.load(&c.shared.u_lobe[base..]);
+    let u = [l.load(&c.shared.u[0][base..]), l.load(&c.shared.u[1][base..])];
     let wm = g.dist.sample_wm(l, wo, u, live & l.bits(facing));
     let cos_om = dot(l, wo, wm);
     let fr = fresnel_dielectric(l, cos_om, g.eta);
@@ -211,12 +186,12 @@ fn rough_dielectric_lanes<L: Lanes>(l: L, c: &mut RoughDielectricChunk, base: us
     let weight = scale(l, value, l.div(one, pdf));
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(kept, black);
-    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
-    store3(l, weight, &mut c.next.weight, base);
-    l.store(pdf, &mut c.next.pdf[base..]);
-    l.store(l.select(reflect, one, fr.eta_ti), &mut c.next.eta[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
+    store3(l, weight, &mut c.shared.next.weight, base);
+    l.store(pdf, &mut c.shared.next.pdf[base..]);
+    l.store(l.select(reflect, one, fr.eta_ti), &mut c.shared.next.eta[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next.dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
+    let wi_world = c.shared.v.world(l, base, wi);
+    store3(l, wi_world, &mut c.shared.next.dir, base);
+    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }

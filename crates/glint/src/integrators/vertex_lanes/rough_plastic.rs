@@ -16,17 +16,14 @@
 //! three times per vertex (at `wo`, towards the light and at the sampled direction), and only
 //! for the lanes that read the result.
 
-use super::columns::{NextEventColumns, NextRayColumns, VertexColumns};
+use super::columns::SharedColumns;
 use super::lane_math::*;
 use super::microfacet::{per_lane, LaneMicrofacet, MicrofacetColumns};
 use super::plastic::{Coating, PlasticColumns};
 use super::smooth::fresnel_dielectric;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use super::{get3, put3, Column, Column3};
 use crate::bsdf::Microfacet;
-use crate::describe::PathSettings;
 use crate::integrators::path::PathState;
-use crate::integrators::Counters;
 use crate::lights::LightSample;
 use crate::materials::{coating_transmittance, PlasticParams, TRANSMITTANCE_RES};
 use crate::math::lanes::{Lanes, MAX_LANES};
@@ -37,22 +34,12 @@ use crate::world::SurfaceInteraction;
 /// Up to [`MAX_LANES`] vertices of rough plastics, one per lane.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct RoughPlasticChunk {
-    pub len: usize,
-    /// Which path each lane is (the caller's index).
-    pub path: [u32; MAX_LANES],
-    pub(super) v: VertexColumns,
-    pub(super) throughput: Column3,
+    /// The vertex, its light sample and random numbers, and the continuation.
+    pub(super) shared: SharedColumns,
     // In: the BSDF: the plastic, its coating's distribution and transmittance table.
     pub(super) bsdf: PlasticColumns,
     pub(super) dist: MicrofacetColumns,
     pub(super) table: [Option<&'static [f32; TRANSMITTANCE_RES]>; MAX_LANES],
-    /// The light sample in, the shadow ray out.
-    pub(super) ne: NextEventColumns,
-    // In: the BSDF's lobe number and square sample.
-    pub(super) u_lobe: Column,
-    pub(super) u: [Column; 2],
-    // Out: the sampled continuation.
-    pub(super) next: NextRayColumns,
 }
 
 impl RoughPlasticChunk {
@@ -72,26 +59,11 @@ impl RoughPlasticChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.len;
-        self.len += 1;
-        self.path[i] = path_index;
-        self.v.put_ray(i, path.ray.dir, si.p);
-        self.v.put_frame(i, si.ng, frame);
-        put3(&mut self.throughput, i, path.throughput().to_array());
+        let i = self.shared.push(path_index, path, si.p, light, rng);
+        self.shared.v.put_frame(i, si.ng, frame);
         self.bsdf.put(i, bsdf);
         self.dist.put(i, dist);
         self.table[i] = bsdf.transmittance;
-        self.ne.put(i, light);
-        self.u_lobe[i] = rng.next_f32();
-        let u = rng.next_2d();
-        self.u[0][i] = u[0];
-        self.u[1][i] = u[1];
-    }
-
-    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, c: &mut Counters) {
-        self.ne.finish(i, path, c);
-        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -144,7 +116,7 @@ fn eval_pdf<L: Lanes>(
 #[inline(always)]
 fn rough_plastic_lanes<L: Lanes>(l: L, c: &mut RoughPlasticChunk, base: usize, live: u32, light_only: bool) {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
-    let wo = c.v.wo_local(l, base);
+    let wo = c.shared.v.wo_local(l, base);
     let dist = c.dist.lanes(l, base);
     // `eval`, `pdf` and `sample` give nothing below the surface (NaN goes on).
     let above = l.not(l.le(wo.z, zero));
@@ -153,16 +125,16 @@ fn rough_plastic_lanes<L: Lanes>(l: L, c: &mut RoughPlasticChunk, base: usize, l
 
     // Next-event estimation: the BSDF towards the light, then what `NextEventColumns::lanes`
     // makes of it.
-    let thr = load3(l, &c.throughput, base);
-    let light_wi = c.v.local(l, base, load3(l, &c.ne.light_wi, base));
+    let thr = load3(l, &c.shared.throughput, base);
+    let light_wi = c.shared.v.local(l, base, load3(l, &c.shared.ne.light_wi, base));
     let (f, bsdf_pdf) = eval_pdf(l, c, base, live, &dist, &coat, wo, light_wi);
-    c.ne.lanes(l, base, &c.v, thr, f, bsdf_pdf, light_only);
+    c.shared.ne.lanes(l, base, &c.shared.v, thr, f, bsdf_pdf, light_only);
 
     // `sample`: where `u_lobe < ps`, a visible normal of the coating and `h * (2.0 *
     // wo.dot(h)) - wo` (not normalized); else the cosine-sampled base. Then `finish`: both
     // lobes' value and density there.
-    let coat_lobe = l.lt(l.load(&c.u_lobe[base..]), coat.ps);
-    let u = [l.load(&c.u[0][base..]), l.load(&c.u[1][base..])];
+    let coat_lobe = l.lt(l.load(&c.shared.u_lobe[base..]), coat.ps);
+    let u = [l.load(&c.shared.u[0][base..]), l.load(&c.shared.u[1][base..])];
     let h = dist.sample_wm(l, wo, u, live & l.bits(l.and(above, coat_lobe)));
     let reflected = sub3(l, scale(l, h, l.mul(l.splat(2.0), dot(l, wo, h))), wo);
     let wi = select3(l, coat_lobe, reflected, cosine_hemisphere(l, u[0], u[1]));
@@ -173,11 +145,11 @@ fn rough_plastic_lanes<L: Lanes>(l: L, c: &mut RoughPlasticChunk, base: usize, l
     let weight = scale(l, value, l.div(one, pdf));
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(kept, black);
-    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
-    store3(l, weight, &mut c.next.weight, base);
-    l.store(pdf, &mut c.next.pdf[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
+    store3(l, weight, &mut c.shared.next.weight, base);
+    l.store(pdf, &mut c.shared.next.pdf[base..]);
     // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next.dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
+    let wi_world = c.shared.v.world(l, base, wi);
+    store3(l, wi_world, &mut c.shared.next.dir, base);
+    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }

@@ -3,14 +3,12 @@
 //! `Bsdf::Dielectric` (the dielectric Fresnel term, reflection or refraction chosen by the
 //! lobe number): no light sample, no shadow ray, the next ray.
 
-use super::columns::{NextRayColumns, VertexColumns};
+use super::columns::SharedColumns;
 use super::lane_math::*;
-use super::{get3, put3, Column, Column3};
-use crate::describe::PathSettings;
+use super::{put3, Column, Column3};
 use crate::integrators::path::PathState;
-use crate::integrators::Counters;
 use crate::materials::{Conductor, Dielectric};
-use crate::math::lanes::{Lanes, MAX_LANES};
+use crate::math::lanes::Lanes;
 use crate::math::Frame;
 use crate::sampling::Sampler;
 use crate::world::SurfaceInteraction;
@@ -25,10 +23,9 @@ pub(crate) enum Smooth {
 /// Up to [`MAX_LANES`] vertices of smooth BSDFs, one per lane.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct SmoothChunk {
-    pub len: usize,
-    pub path: [u32; MAX_LANES],
-    // In: the vertex and the BSDF.
-    pub(super) v: VertexColumns,
+    /// The vertex, its light sample and random numbers, and the continuation.
+    pub(super) shared: SharedColumns,
+    // In: the BSDF.
     /// 1 for a dielectric, 0 for a conductor.
     pub(super) glass: Column,
     /// The conductor's eta, k and specular reflectance; the dielectric's eta (in the first
@@ -37,9 +34,6 @@ pub(crate) struct SmoothChunk {
     pub(super) k: Column3,
     pub(super) specular: Column3,
     pub(super) transmit: Column3,
-    pub(super) u_lobe: Column,
-    // Out: the sampled continuation.
-    pub(super) next: NextRayColumns,
 }
 
 impl SmoothChunk {
@@ -54,11 +48,9 @@ impl SmoothChunk {
         bsdf: Smooth,
         rng: &mut Sampler,
     ) {
-        let i = self.len;
-        self.len += 1;
-        self.path[i] = path_index;
-        self.v.put_ray(i, path.ray.dir, si.p);
-        self.v.put_frame(i, si.ng, frame);
+        // A delta BSDF: no light sample.
+        let i = self.shared.push(path_index, path, si.p, None, rng);
+        self.shared.v.put_frame(i, si.ng, frame);
         match bsdf {
             Smooth::Conductor(m) => {
                 self.glass[i] = 0.0;
@@ -75,13 +67,6 @@ impl SmoothChunk {
                 put3(&mut self.transmit, i, d.transmit.to_array());
             }
         }
-        self.u_lobe[i] = rng.next_f32();
-        let _u = rng.next_2d();
-    }
-
-    /// Writes lane `i`'s results into its path, as the end of `PathState::scatter` does.
-    pub fn finish(&self, i: usize, path: &mut PathState, s: &PathSettings, rng: &mut Sampler, _c: &mut Counters) {
-        self.next.finish(i, path, s, rng, get3(&self.v.p, i));
     }
 }
 
@@ -92,7 +77,7 @@ lane_kernel!(SmoothChunk, smooth_lanes);
 #[inline(always)]
 fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize, _live: u32, _light_only: bool) {
     let (zero, one) = (l.splat(0.0), l.splat(1.0));
-    let wo = c.v.wo_local(l, base);
+    let wo = c.shared.v.wo_local(l, base);
     let (eta, spec) = (load3(l, &c.eta, base), load3(l, &c.specular, base));
     let glass = l.gt(l.load(&c.glass[base..]), zero);
     let mirror = l.not(glass);
@@ -109,7 +94,7 @@ fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize, _live: u32, _l
     }
     if l.bits(glass) != 0 {
         let fr = fresnel_dielectric(l, wo.z, eta.x);
-        let reflect = l.lt(l.load(&c.u_lobe[base..]), fr.reflectance);
+        let reflect = l.lt(l.load(&c.shared.u_lobe[base..]), fr.reflectance);
         // `refract_local(wo, fr)`, and the radiance scale 1 / eta_ti².
         let k = l.div(l.splat(-1.0), fr.eta_ti);
         let refracted = V3 { x: l.mul(wo.x, k), y: l.mul(wo.y, k), z: fr.cos_t };
@@ -123,15 +108,15 @@ fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize, _live: u32, _l
     }
     let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
     let sampled = l.and_not(sampled, black);
-    l.store(l.select(sampled, one, zero), &mut c.next.sampled[base..]);
+    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
     // A delta sample of density 1.
-    l.store(one, &mut c.next.pdf[base..]);
-    l.store(one, &mut c.next.delta[base..]);
-    store3(l, weight, &mut c.next.weight, base);
-    l.store(eta_out, &mut c.next.eta[base..]);
-    let wi_world = c.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.next.dir, base);
-    store3(l, c.v.spawn_origin(l, base, wi_world), &mut c.next.origin, base);
+    l.store(one, &mut c.shared.next.pdf[base..]);
+    l.store(one, &mut c.shared.next.delta[base..]);
+    store3(l, weight, &mut c.shared.next.weight, base);
+    l.store(eta_out, &mut c.shared.next.eta[base..]);
+    let wi_world = c.shared.v.world(l, base, wi);
+    store3(l, wi_world, &mut c.shared.next.dir, base);
+    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }
 
 /// `bsdf::DielectricFresnel` over lanes.

@@ -113,28 +113,29 @@ fn reference(v: &Vertex, light_only: bool) -> Outcome {
 }
 
 fn fill(c: &mut DiffuseChunk, i: usize, v: &Vertex) {
-    c.len = c.len.max(i + 1);
-    c.v.put_ray(i, v.dir, v.p);
-    c.v.put_frame(i, v.ng, &v.frame);
+    c.shared.len = c.shared.len.max(i + 1);
+    c.shared.v.put_ray(i, v.dir, v.p);
+    c.shared.v.put_frame(i, v.ng, &v.frame);
     put3(&mut c.reflectance, i, v.reflectance.to_array());
-    put3(&mut c.throughput, i, v.throughput.to_array());
-    c.ne.put(i, v.light.map(|ls| (ls, v.pick_pmf)));
-    c.u[0][i] = v.u[0];
-    c.u[1][i] = v.u[1];
+    put3(&mut c.shared.throughput, i, v.throughput.to_array());
+    c.shared.ne.put(i, v.light.map(|ls| (ls, v.pick_pmf)));
+    c.shared.u[0][i] = v.u[0];
+    c.shared.u[1][i] = v.u[1];
 }
 
 fn outcome(c: &DiffuseChunk, i: usize) -> Outcome {
-    let shadow = (c.ne.shadow[i] != 0.0).then(|| {
+    let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
         (
-            bits(get3(&c.ne.shadow_origin, i)),
-            bits(get3(&c.ne.shadow_dir, i)),
-            bits1(c.ne.shadow_t_max[i]),
-            bits(get3(&c.ne.contribution, i)),
-            bits1(c.ne.mis_weight[i]),
+            bits(get3(&c.shared.ne.shadow_origin, i)),
+            bits(get3(&c.shared.ne.shadow_dir, i)),
+            bits1(c.shared.ne.shadow_t_max[i]),
+            bits(get3(&c.shared.ne.contribution, i)),
+            bits1(c.shared.ne.mis_weight[i]),
         )
     });
-    let next = (c.next.sampled[i] != 0.0)
-        .then(|| (bits(get3(&c.next.origin, i)), bits(get3(&c.next.dir, i)), bits1(c.next.pdf[i])));
+    let next = (c.shared.next.sampled[i] != 0.0).then(|| {
+        (bits(get3(&c.shared.next.origin, i)), bits(get3(&c.shared.next.dir, i)), bits1(c.shared.next.pdf[i]))
+    });
     Outcome { shadow, next }
 }
 
@@ -305,17 +306,23 @@ fn check_mesh_frames(isa: LaneIsa) {
                 want.push((v.ng, v.frame));
             } else {
                 let (hit, p, dir) = mesh_hit(&mut rng);
-                chunk.len = i;
+                chunk.shared.len = i;
                 let mut sampler = Sampler::from_rng(Rng::new(1, i as u64));
                 let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, dir));
                 chunk.push_mesh(i as u32, &path, &hit, p, None, &mut sampler);
                 want.push(reference_frame(&hit, dir));
             }
         }
-        chunk.len = lanes;
+        chunk.shared.len = lanes;
         chunk.run(isa, Strategy::Mis);
         for (i, (ng, frame)) in want.iter().enumerate() {
-            let got = [get3(&chunk.v.ng, i), get3(&chunk.v.n, i), get3(&chunk.v.s, i), get3(&chunk.v.t, i)].map(bits);
+            let got = [
+                get3(&chunk.shared.v.ng, i),
+                get3(&chunk.shared.v.n, i),
+                get3(&chunk.shared.v.s, i),
+                get3(&chunk.shared.v.t, i),
+            ]
+            .map(bits);
             let expected = [*ng, frame.n, frame.s, frame.t].map(bits);
             assert_eq!(got, expected, "{isa:?} lane {i}, round {round}");
         }
@@ -376,7 +383,7 @@ fn check_smooth(isa: LaneIsa) {
                 Smooth::Conductor(m) => Bsdf::Conductor(m),
                 Smooth::Dielectric(d) => Bsdf::Dielectric(d),
             };
-            let sample = scalar.sample(wo, chunk.u_lobe[i], [0.5, 0.5]).filter(|bs| !bs.weight.is_black());
+            let sample = scalar.sample(wo, chunk.shared.u_lobe[i], [0.5, 0.5]).filter(|bs| !bs.weight.is_black());
             want.push(sample.map(|bs| {
                 let r = spawn_ray(&si, v.frame.to_world(bs.wi));
                 (bits(r.origin), bits(r.dir), bits(vec3(bs.weight.r, bs.weight.g, bs.weight.b)), bits1(bs.eta))
@@ -384,12 +391,12 @@ fn check_smooth(isa: LaneIsa) {
         }
         chunk.run(isa, Strategy::Mis);
         for (i, w) in want.iter().enumerate() {
-            let got = (chunk.next.sampled[i] != 0.0).then(|| {
+            let got = (chunk.shared.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.next.origin, i)),
-                    bits(get3(&chunk.next.dir, i)),
-                    bits(get3(&chunk.next.weight, i)),
-                    bits1(chunk.next.eta[i]),
+                    bits(get3(&chunk.shared.next.origin, i)),
+                    bits(get3(&chunk.shared.next.dir, i)),
+                    bits(get3(&chunk.shared.next.weight, i)),
+                    bits1(chunk.shared.next.eta[i]),
                 )
             });
             assert_eq!(&got, w, "{isa:?} lane {i}, round {round}");
@@ -583,9 +590,9 @@ fn check_rough(isa: LaneIsa) {
             let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
             chunk.push(i as u32, &path, &si, &v.frame, &m, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
             // The vertex's own throughput and square, in place of a new path's and the sampler's.
-            put3(&mut chunk.throughput, i, v.throughput.to_array());
-            chunk.u[0][i] = v.u[0];
-            chunk.u[1][i] = v.u[1];
+            put3(&mut chunk.shared.throughput, i, v.throughput.to_array());
+            chunk.shared.u[0][i] = v.u[0];
+            chunk.shared.u[1][i] = v.u[1];
             let bsdf = Bsdf::RoughConductor(m);
             let wo = v.frame.to_local(-v.dir);
             let next = bsdf.sample(wo, 0.5, v.u).filter(|bs| !bs.weight.is_black()).map(|bs| {
@@ -596,21 +603,21 @@ fn check_rough(isa: LaneIsa) {
         }
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (shadow, next, v, m)) in want.iter().enumerate() {
-            let got_shadow = (chunk.ne.shadow[i] != 0.0).then(|| {
+            let got_shadow = (chunk.shared.ne.shadow[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.ne.shadow_origin, i)),
-                    bits(get3(&chunk.ne.shadow_dir, i)),
-                    bits1(chunk.ne.shadow_t_max[i]),
-                    bits(get3(&chunk.ne.contribution, i)),
-                    bits1(chunk.ne.mis_weight[i]),
+                    bits(get3(&chunk.shared.ne.shadow_origin, i)),
+                    bits(get3(&chunk.shared.ne.shadow_dir, i)),
+                    bits1(chunk.shared.ne.shadow_t_max[i]),
+                    bits(get3(&chunk.shared.ne.contribution, i)),
+                    bits1(chunk.shared.ne.mis_weight[i]),
                 )
             });
-            let got_next = (chunk.next.sampled[i] != 0.0).then(|| {
+            let got_next = (chunk.shared.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.next.origin, i)),
-                    bits(get3(&chunk.next.dir, i)),
-                    bits1(chunk.next.pdf[i]),
-                    bits(get3(&chunk.next.weight, i)),
+                    bits(get3(&chunk.shared.next.origin, i)),
+                    bits(get3(&chunk.shared.next.dir, i)),
+                    bits1(chunk.shared.next.pdf[i]),
+                    bits(get3(&chunk.shared.next.weight, i)),
                 )
             });
             assert_eq!(&got_shadow, shadow, "{isa:?} lane {i}, round {round}, shadow: {m:?} {v:?}");
@@ -714,28 +721,28 @@ fn check_principled(isa: LaneIsa) {
             let mut sampler = Sampler::from_rng(Rng::new(3, (round * lanes + i) as u64));
             let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
             chunk.push(i as u32, &path, &si, &v.frame, &b, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
-            let u = [chunk.u[0][i], chunk.u[1][i]];
-            want.push((reference_scatter(&v, &Bsdf::Principled(b), chunk.u_lobe[i], u, light_only), v, b));
+            let u = [chunk.shared.u[0][i], chunk.shared.u[1][i]];
+            want.push((reference_scatter(&v, &Bsdf::Principled(b), chunk.shared.u_lobe[i], u, light_only), v, b));
         }
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (w, v, b)) in want.iter().enumerate() {
             let c = &chunk;
-            let shadow = (c.ne.shadow[i] != 0.0).then(|| {
+            let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.ne.shadow_origin, i)),
-                    bits(get3(&c.ne.shadow_dir, i)),
-                    bits1(c.ne.shadow_t_max[i]),
-                    bits(get3(&c.ne.contribution, i)),
-                    bits1(c.ne.mis_weight[i]),
+                    bits(get3(&c.shared.ne.shadow_origin, i)),
+                    bits(get3(&c.shared.ne.shadow_dir, i)),
+                    bits1(c.shared.ne.shadow_t_max[i]),
+                    bits(get3(&c.shared.ne.contribution, i)),
+                    bits1(c.shared.ne.mis_weight[i]),
                 )
             });
-            let next = (c.next.sampled[i] != 0.0).then(|| {
+            let next = (c.shared.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.next.origin, i)),
-                    bits(get3(&c.next.dir, i)),
-                    bits(get3(&c.next.weight, i)),
-                    bits1(c.next.pdf[i]),
-                    bits1(c.next.eta[i]),
+                    bits(get3(&c.shared.next.origin, i)),
+                    bits(get3(&c.shared.next.dir, i)),
+                    bits(get3(&c.shared.next.weight, i)),
+                    bits1(c.shared.next.pdf[i]),
+                    bits1(c.shared.next.eta[i]),
                 )
             });
             assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {b:?}");
@@ -851,36 +858,36 @@ fn check_plastic(isa: LaneIsa) {
             let no_roulette = PathSettings { rr_depth: u32::MAX, ..Default::default() };
             path.go_on(&no_roulette, v.throughput, 1.0, prev, Ray::new(Vec3::ZERO, v.dir), &mut sampler);
             chunk.push(i as u32, &path, &si, &v.frame, &p, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
-            chunk.u_lobe[i] = u_lobe;
-            chunk.u[0][i] = v.u[0];
-            chunk.u[1][i] = v.u[1];
+            chunk.shared.u_lobe[i] = u_lobe;
+            chunk.shared.u[0][i] = v.u[0];
+            chunk.shared.u[1][i] = v.u[1];
             want.push((v, p, plastic_reference(&v, &p, u_lobe, light_only)));
         }
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (v, p, want)) in want.iter().enumerate() {
-            let shadow = (chunk.ne.shadow[i] != 0.0).then(|| {
+            let shadow = (chunk.shared.ne.shadow[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.ne.shadow_origin, i)),
-                    bits(get3(&chunk.ne.shadow_dir, i)),
-                    bits1(chunk.ne.shadow_t_max[i]),
-                    bits(get3(&chunk.ne.contribution, i)),
-                    bits1(chunk.ne.mis_weight[i]),
+                    bits(get3(&chunk.shared.ne.shadow_origin, i)),
+                    bits(get3(&chunk.shared.ne.shadow_dir, i)),
+                    bits1(chunk.shared.ne.shadow_t_max[i]),
+                    bits(get3(&chunk.shared.ne.contribution, i)),
+                    bits1(chunk.shared.ne.mis_weight[i]),
                 )
             });
-            let next = (chunk.next.sampled[i] != 0.0).then(|| {
+            let next = (chunk.shared.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&chunk.next.origin, i)),
-                    bits(get3(&chunk.next.dir, i)),
-                    bits1(chunk.next.pdf[i]),
-                    bits(get3(&chunk.next.weight, i)),
-                    chunk.next.delta[i] != 0.0,
+                    bits(get3(&chunk.shared.next.origin, i)),
+                    bits(get3(&chunk.shared.next.dir, i)),
+                    bits1(chunk.shared.next.pdf[i]),
+                    bits(get3(&chunk.shared.next.weight, i)),
+                    chunk.shared.next.delta[i] != 0.0,
                 )
             });
             assert_eq!(
                 &(shadow, next),
                 want,
                 "{isa:?} lane {i}, round {round}: {v:?} {p:?} u_lobe {}",
-                chunk.u_lobe[i]
+                chunk.shared.u_lobe[i]
             );
             total += 1;
             shadows += want.0.is_some() as u32;
@@ -980,10 +987,10 @@ fn check_rough_dielectric(isa: LaneIsa) {
             let path = PathState::new(&PathSettings::default(), &Ray::new(Vec3::ZERO, v.dir));
             chunk.push(i as u32, &path, &si, &v.frame, &b, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
             // The vertex's own throughput and numbers, in place of a new path's and the sampler's.
-            put3(&mut chunk.throughput, i, v.throughput.to_array());
-            chunk.u_lobe[i] = u_lobe;
-            chunk.u[0][i] = v.u[0];
-            chunk.u[1][i] = v.u[1];
+            put3(&mut chunk.shared.throughput, i, v.throughput.to_array());
+            chunk.shared.u_lobe[i] = u_lobe;
+            chunk.shared.u[0][i] = v.u[0];
+            chunk.shared.u[1][i] = v.u[1];
             let bsdf = Bsdf::RoughDielectric(b);
             let wo = v.frame.to_local(-v.dir);
             let kind = bsdf.sample(wo, u_lobe, v.u).filter(|bs| !bs.weight.is_black()).map(|bs| bs.wi.z * wo.z < 0.0);
@@ -992,25 +999,30 @@ fn check_rough_dielectric(isa: LaneIsa) {
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (w, kind, below, v, b)) in want.iter().enumerate() {
             let c = &chunk;
-            let shadow = (c.ne.shadow[i] != 0.0).then(|| {
+            let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.ne.shadow_origin, i)),
-                    bits(get3(&c.ne.shadow_dir, i)),
-                    bits1(c.ne.shadow_t_max[i]),
-                    bits(get3(&c.ne.contribution, i)),
-                    bits1(c.ne.mis_weight[i]),
+                    bits(get3(&c.shared.ne.shadow_origin, i)),
+                    bits(get3(&c.shared.ne.shadow_dir, i)),
+                    bits1(c.shared.ne.shadow_t_max[i]),
+                    bits(get3(&c.shared.ne.contribution, i)),
+                    bits1(c.shared.ne.mis_weight[i]),
                 )
             });
-            let next = (c.next.sampled[i] != 0.0).then(|| {
+            let next = (c.shared.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.next.origin, i)),
-                    bits(get3(&c.next.dir, i)),
-                    bits(get3(&c.next.weight, i)),
-                    bits1(c.next.pdf[i]),
-                    bits1(c.next.eta[i]),
+                    bits(get3(&c.shared.next.origin, i)),
+                    bits(get3(&c.shared.next.dir, i)),
+                    bits(get3(&c.shared.next.weight, i)),
+                    bits1(c.shared.next.pdf[i]),
+                    bits1(c.shared.next.eta[i]),
                 )
             });
-            assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {b:?} u_lobe {}", c.u_lobe[i]);
+            assert_eq!(
+                &(shadow, next),
+                w,
+                "{isa:?} lane {i}, round {round}: {v:?} {b:?} u_lobe {}",
+                c.shared.u_lobe[i]
+            );
             total += 1;
             shadows += w.0.is_some() as u32;
             match kind {
@@ -1111,36 +1123,41 @@ fn check_rough_plastic(isa: LaneIsa) {
             chunk.push(i as u32, &path, &si, &v.frame, &p, &dist, v.light.map(|ls| (ls, v.pick_pmf)), &mut sampler);
             // The vertex's own throughput, lobe number and square, in place of a new path's
             // and the sampler's.
-            put3(&mut chunk.throughput, i, v.throughput.to_array());
-            chunk.u_lobe[i] = u_lobe;
-            chunk.u[0][i] = v.u[0];
-            chunk.u[1][i] = v.u[1];
+            put3(&mut chunk.shared.throughput, i, v.throughput.to_array());
+            chunk.shared.u_lobe[i] = u_lobe;
+            chunk.shared.u[0][i] = v.u[0];
+            chunk.shared.u[1][i] = v.u[1];
             let coat_lobe = plastic_ps(&v, &p).is_some_and(|ps| u_lobe < ps);
             want.push((reference_scatter(&v, &Bsdf::Plastic(p), u_lobe, v.u, light_only), coat_lobe, v, p));
         }
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (w, coat_lobe, v, p)) in want.iter().enumerate() {
             let c = &chunk;
-            let shadow = (c.ne.shadow[i] != 0.0).then(|| {
+            let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.ne.shadow_origin, i)),
-                    bits(get3(&c.ne.shadow_dir, i)),
-                    bits1(c.ne.shadow_t_max[i]),
-                    bits(get3(&c.ne.contribution, i)),
-                    bits1(c.ne.mis_weight[i]),
+                    bits(get3(&c.shared.ne.shadow_origin, i)),
+                    bits(get3(&c.shared.ne.shadow_dir, i)),
+                    bits1(c.shared.ne.shadow_t_max[i]),
+                    bits(get3(&c.shared.ne.contribution, i)),
+                    bits1(c.shared.ne.mis_weight[i]),
                 )
             });
-            let next = (c.next.sampled[i] != 0.0).then(|| {
+            let next = (c.shared.next.sampled[i] != 0.0).then(|| {
                 (
-                    bits(get3(&c.next.origin, i)),
-                    bits(get3(&c.next.dir, i)),
-                    bits(get3(&c.next.weight, i)),
-                    bits1(c.next.pdf[i]),
+                    bits(get3(&c.shared.next.origin, i)),
+                    bits(get3(&c.shared.next.dir, i)),
+                    bits(get3(&c.shared.next.weight, i)),
+                    bits1(c.shared.next.pdf[i]),
                     // A rough plastic's samples keep the index (`go_on`'s eta of 1).
                     1.0f32.to_bits(),
                 )
             });
-            assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {p:?} u_lobe {}", c.u_lobe[i]);
+            assert_eq!(
+                &(shadow, next),
+                w,
+                "{isa:?} lane {i}, round {round}: {v:?} {p:?} u_lobe {}",
+                c.shared.u_lobe[i]
+            );
             total += 1;
             shadows += w.0.is_some() as u32;
             match (w.1.is_some(), coat_lobe) {
