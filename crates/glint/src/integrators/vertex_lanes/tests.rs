@@ -6,6 +6,7 @@
 //! payload: Rust leaves those unspecified (LLVM may swap the operands of a multiplication),
 //! and the film discards a sample that is not finite.
 
+use super::columns::SharedColumns;
 use super::diffuse::DiffuseChunk;
 use super::lane_math::{load3, store3};
 use super::microfacet::MicrofacetColumns;
@@ -49,6 +50,52 @@ fn bits1(x: f32) -> u32 {
 
 fn bits(v: Vec3) -> [u32; 3] {
     [bits1(v.x), bits1(v.y), bits1(v.z)]
+}
+
+/// Runs `check` on every lane width the CPU has, saying which ones it cannot test here.
+fn on_every_isa(kernel: &str, check: fn(LaneIsa)) {
+    check(LaneIsa::One);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if Avx2x8::new().is_some() {
+            check(LaneIsa::Avx2);
+        } else {
+            eprintln!("no AVX2 on this CPU: the eight-lane {kernel} kernel is not tested here");
+        }
+        if Avx512x16::new().is_some() {
+            check(LaneIsa::Avx512);
+        } else {
+            eprintln!("no AVX-512F on this CPU: the sixteen-lane {kernel} kernel is not tested here");
+        }
+    }
+}
+
+/// The shadow ray lane `i` left, as bits.
+fn shadow_bits(c: &SharedColumns, i: usize) -> Option<ShadowBits> {
+    let ne = &c.ne;
+    (ne.shadow[i] != 0.0).then(|| {
+        (
+            bits(get3(&ne.shadow_origin, i)),
+            bits(get3(&ne.shadow_dir, i)),
+            bits1(ne.shadow_t_max[i]),
+            bits(get3(&ne.contribution, i)),
+            bits1(ne.mis_weight[i]),
+        )
+    })
+}
+
+/// The continuation lane `i` left (origin, direction, weight, density, eta), as bits.
+fn sample_bits(c: &SharedColumns, i: usize) -> Option<SampleBits> {
+    let next = &c.next;
+    (next.sampled[i] != 0.0).then(|| {
+        (
+            bits(get3(&next.origin, i)),
+            bits(get3(&next.dir, i)),
+            bits(get3(&next.weight, i)),
+            bits1(next.pdf[i]),
+            bits1(next.eta[i]),
+        )
+    })
 }
 
 /// One lane's vertex.
@@ -124,15 +171,7 @@ fn fill(c: &mut DiffuseChunk, i: usize, v: &Vertex) {
 }
 
 fn outcome(c: &DiffuseChunk, i: usize) -> Outcome {
-    let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
-        (
-            bits(get3(&c.shared.ne.shadow_origin, i)),
-            bits(get3(&c.shared.ne.shadow_dir, i)),
-            bits1(c.shared.ne.shadow_t_max[i]),
-            bits(get3(&c.shared.ne.contribution, i)),
-            bits1(c.shared.ne.mis_weight[i]),
-        )
-    });
+    let shadow = shadow_bits(&c.shared, i);
     let next = (c.shared.next.sampled[i] != 0.0).then(|| {
         (bits(get3(&c.shared.next.origin, i)), bits(get3(&c.shared.next.dir, i)), bits1(c.shared.next.pdf[i]))
     });
@@ -231,20 +270,7 @@ fn check(isa: LaneIsa) {
 
 #[test]
 fn every_lane_scatters_as_the_one_path_code_does() {
-    check(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check(LaneIsa::Avx2);
-        } else {
-            eprintln!("no AVX2 on this CPU: the eight-lane kernel is not tested here");
-        }
-        if Avx512x16::new().is_some() {
-            check(LaneIsa::Avx512);
-        } else {
-            eprintln!("no AVX-512F on this CPU: the sixteen-lane kernel is not tested here");
-        }
-    }
+    on_every_isa("diffuse", check);
 }
 
 /// A triangle hit for the interaction kernel: random corners (degenerate ones and special
@@ -331,16 +357,7 @@ fn check_mesh_frames(isa: LaneIsa) {
 
 #[test]
 fn every_lane_finds_the_mesh_frame_the_one_path_code_finds() {
-    check_mesh_frames(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check_mesh_frames(LaneIsa::Avx2);
-        }
-        if Avx512x16::new().is_some() {
-            check_mesh_frames(LaneIsa::Avx512);
-        }
-    }
+    on_every_isa("mesh interaction", check_mesh_frames);
 }
 
 /// The smooth BSDFs' lanes against `Conductor::sample` and `Dielectric::sample` (with the
@@ -413,16 +430,7 @@ fn check_smooth(isa: LaneIsa) {
 
 #[test]
 fn every_lane_samples_smooth_bsdfs_as_the_one_path_code_does() {
-    check_smooth(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check_smooth(LaneIsa::Avx2);
-        }
-        if Avx512x16::new().is_some() {
-            check_smooth(LaneIsa::Avx512);
-        }
-    }
+    on_every_isa("smooth BSDF", check_smooth);
 }
 
 /// The lanes' dielectric Fresnel term against `bsdf::fresnel_dielectric` (whose reflectance
@@ -603,15 +611,7 @@ fn check_rough(isa: LaneIsa) {
         }
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (shadow, next, v, m)) in want.iter().enumerate() {
-            let got_shadow = (chunk.shared.ne.shadow[i] != 0.0).then(|| {
-                (
-                    bits(get3(&chunk.shared.ne.shadow_origin, i)),
-                    bits(get3(&chunk.shared.ne.shadow_dir, i)),
-                    bits1(chunk.shared.ne.shadow_t_max[i]),
-                    bits(get3(&chunk.shared.ne.contribution, i)),
-                    bits1(chunk.shared.ne.mis_weight[i]),
-                )
-            });
+            let got_shadow = shadow_bits(&chunk.shared, i);
             let got_next = (chunk.shared.next.sampled[i] != 0.0).then(|| {
                 (
                     bits(get3(&chunk.shared.next.origin, i)),
@@ -636,20 +636,7 @@ fn check_rough(isa: LaneIsa) {
 
 #[test]
 fn every_lane_scatters_off_rough_conductors_as_the_one_path_code_does() {
-    check_rough(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check_rough(LaneIsa::Avx2);
-        } else {
-            eprintln!("no AVX2 on this CPU: the eight-lane rough conductor kernel is not tested here");
-        }
-        if Avx512x16::new().is_some() {
-            check_rough(LaneIsa::Avx512);
-        } else {
-            eprintln!("no AVX-512F on this CPU: the sixteen-lane rough conductor kernel is not tested here");
-        }
-    }
+    on_every_isa("rough conductor", check_rough);
 }
 
 /// The one-path code's whole step at `v` for a BSDF that is not delta: the shadow ray, then
@@ -727,24 +714,8 @@ fn check_principled(isa: LaneIsa) {
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (w, v, b)) in want.iter().enumerate() {
             let c = &chunk;
-            let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
-                (
-                    bits(get3(&c.shared.ne.shadow_origin, i)),
-                    bits(get3(&c.shared.ne.shadow_dir, i)),
-                    bits1(c.shared.ne.shadow_t_max[i]),
-                    bits(get3(&c.shared.ne.contribution, i)),
-                    bits1(c.shared.ne.mis_weight[i]),
-                )
-            });
-            let next = (c.shared.next.sampled[i] != 0.0).then(|| {
-                (
-                    bits(get3(&c.shared.next.origin, i)),
-                    bits(get3(&c.shared.next.dir, i)),
-                    bits(get3(&c.shared.next.weight, i)),
-                    bits1(c.shared.next.pdf[i]),
-                    bits1(c.shared.next.eta[i]),
-                )
-            });
+            let shadow = shadow_bits(&c.shared, i);
+            let next = sample_bits(&c.shared, i);
             assert_eq!(&(shadow, next), w, "{isa:?} lane {i}, round {round}: {v:?} {b:?}");
             total += 1;
             shadows += w.0.is_some() as u32;
@@ -760,16 +731,7 @@ fn check_principled(isa: LaneIsa) {
 
 #[test]
 fn every_lane_scatters_off_the_principled_bsdf_as_the_one_path_code_does() {
-    check_principled(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check_principled(LaneIsa::Avx2);
-        }
-        if Avx512x16::new().is_some() {
-            check_principled(LaneIsa::Avx512);
-        }
-    }
+    on_every_isa("principled", check_principled);
 }
 
 /// A smooth plastic for the plastic kernel: dielectric-like indices (index-matched, inside
@@ -865,15 +827,7 @@ fn check_plastic(isa: LaneIsa) {
         }
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (v, p, want)) in want.iter().enumerate() {
-            let shadow = (chunk.shared.ne.shadow[i] != 0.0).then(|| {
-                (
-                    bits(get3(&chunk.shared.ne.shadow_origin, i)),
-                    bits(get3(&chunk.shared.ne.shadow_dir, i)),
-                    bits1(chunk.shared.ne.shadow_t_max[i]),
-                    bits(get3(&chunk.shared.ne.contribution, i)),
-                    bits1(chunk.shared.ne.mis_weight[i]),
-                )
-            });
+            let shadow = shadow_bits(&chunk.shared, i);
             let next = (chunk.shared.next.sampled[i] != 0.0).then(|| {
                 (
                     bits(get3(&chunk.shared.next.origin, i)),
@@ -906,20 +860,7 @@ fn check_plastic(isa: LaneIsa) {
 
 #[test]
 fn every_lane_scatters_off_smooth_plastic_as_the_one_path_code_does() {
-    check_plastic(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check_plastic(LaneIsa::Avx2);
-        } else {
-            eprintln!("no AVX2 on this CPU: the eight-lane plastic kernel is not tested here");
-        }
-        if Avx512x16::new().is_some() {
-            check_plastic(LaneIsa::Avx512);
-        } else {
-            eprintln!("no AVX-512F on this CPU: the sixteen-lane plastic kernel is not tested here");
-        }
-    }
+    on_every_isa("smooth plastic", check_plastic);
 }
 
 /// A rough dielectric: glass-like indices from either side (index-matched, below 1, above 1,
@@ -999,24 +940,8 @@ fn check_rough_dielectric(isa: LaneIsa) {
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (w, kind, below, v, b)) in want.iter().enumerate() {
             let c = &chunk;
-            let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
-                (
-                    bits(get3(&c.shared.ne.shadow_origin, i)),
-                    bits(get3(&c.shared.ne.shadow_dir, i)),
-                    bits1(c.shared.ne.shadow_t_max[i]),
-                    bits(get3(&c.shared.ne.contribution, i)),
-                    bits1(c.shared.ne.mis_weight[i]),
-                )
-            });
-            let next = (c.shared.next.sampled[i] != 0.0).then(|| {
-                (
-                    bits(get3(&c.shared.next.origin, i)),
-                    bits(get3(&c.shared.next.dir, i)),
-                    bits(get3(&c.shared.next.weight, i)),
-                    bits1(c.shared.next.pdf[i]),
-                    bits1(c.shared.next.eta[i]),
-                )
-            });
+            let shadow = shadow_bits(&c.shared, i);
+            let next = sample_bits(&c.shared, i);
             assert_eq!(
                 &(shadow, next),
                 w,
@@ -1048,20 +973,7 @@ fn check_rough_dielectric(isa: LaneIsa) {
 
 #[test]
 fn every_lane_scatters_off_rough_dielectrics_as_the_one_path_code_does() {
-    check_rough_dielectric(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check_rough_dielectric(LaneIsa::Avx2);
-        } else {
-            eprintln!("no AVX2 on this CPU: the eight-lane rough dielectric kernel is not tested here");
-        }
-        if Avx512x16::new().is_some() {
-            check_rough_dielectric(LaneIsa::Avx512);
-        } else {
-            eprintln!("no AVX-512F on this CPU: the sixteen-lane rough dielectric kernel is not tested here");
-        }
-    }
+    on_every_isa("rough dielectric", check_rough_dielectric);
 }
 
 /// A rough plastic for the rough plastic kernel. The coating's tables are interned per
@@ -1133,15 +1045,7 @@ fn check_rough_plastic(isa: LaneIsa) {
         chunk.run(isa, if light_only { Strategy::Light } else { Strategy::Mis });
         for (i, (w, coat_lobe, v, p)) in want.iter().enumerate() {
             let c = &chunk;
-            let shadow = (c.shared.ne.shadow[i] != 0.0).then(|| {
-                (
-                    bits(get3(&c.shared.ne.shadow_origin, i)),
-                    bits(get3(&c.shared.ne.shadow_dir, i)),
-                    bits1(c.shared.ne.shadow_t_max[i]),
-                    bits(get3(&c.shared.ne.contribution, i)),
-                    bits1(c.shared.ne.mis_weight[i]),
-                )
-            });
+            let shadow = shadow_bits(&c.shared, i);
             let next = (c.shared.next.sampled[i] != 0.0).then(|| {
                 (
                     bits(get3(&c.shared.next.origin, i)),
@@ -1179,18 +1083,5 @@ fn check_rough_plastic(isa: LaneIsa) {
 
 #[test]
 fn every_lane_scatters_off_rough_plastic_as_the_one_path_code_does() {
-    check_rough_plastic(LaneIsa::One);
-    #[cfg(target_arch = "x86_64")]
-    {
-        if Avx2x8::new().is_some() {
-            check_rough_plastic(LaneIsa::Avx2);
-        } else {
-            eprintln!("no AVX2 on this CPU: the eight-lane rough plastic kernel is not tested here");
-        }
-        if Avx512x16::new().is_some() {
-            check_rough_plastic(LaneIsa::Avx512);
-        } else {
-            eprintln!("no AVX-512F on this CPU: the sixteen-lane rough plastic kernel is not tested here");
-        }
-    }
+    on_every_isa("rough plastic", check_rough_plastic);
 }
