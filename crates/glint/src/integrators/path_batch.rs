@@ -49,6 +49,8 @@ pub fn li_batch(
     // Closest hits in packets for the camera rays only (the first wave): they are coherent;
     // later waves' rays scatter, and go through the single-ray kernels (same bits either way).
     let mut closest = traversal;
+    // The BSDF classes' chunks (tens of KiB): made once, each emptied by every wave's flush.
+    let mut stepper = (shading == PathShading::Lanes).then(|| LaneStepper::new(LaneIsa::detect()));
     while !live.is_empty() {
         // Camera rays that look through hidden emitters are traced one at a time (below).
         rays.clear();
@@ -79,9 +81,8 @@ pub fn li_batch(
             stepping.push(Stepping { path: i, hit });
         }
         order.sort_unstable();
-        if let PathShading::Lanes = shading {
-            // The same loop, the Lambertian vertices' arithmetic in lanes (`vertex_lanes`).
-            let mut stepper = LaneStepper::new(LaneIsa::detect());
+        if let Some(stepper) = stepper.as_mut() {
+            // The same loop, the covered BSDFs' arithmetic in lanes (`vertex_lanes`).
             for (k, &o) in order.iter().enumerate() {
                 if scene.prefetch_hits {
                     prefetch_ahead(scene, &stepping, &order, k);

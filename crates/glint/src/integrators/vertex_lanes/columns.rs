@@ -217,6 +217,13 @@ impl NextRayColumns {
     }
 }
 
+/// Whether a BSDF reads the lobe number `PathState::scatter` draws for it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Lobe {
+    Read,
+    Unread,
+}
+
 /// What every chunk holds besides its BSDF's parameters: which path each lane is, its vertex,
 /// throughput, light sample and the BSDF's random numbers in, the continuation out.
 #[derive(Clone, Copy, Default)]
@@ -235,14 +242,17 @@ pub(crate) struct SharedColumns {
 impl SharedColumns {
     /// Adds path `index`'s vertex at `p` as the next lane (its frame is the caller's to put)
     /// with the light sample the caller drew, then draws the BSDF's random numbers from `rng`
-    /// as `PathState::scatter` draws them after the light sample: the lobe number, then the
-    /// square. Returns the lane.
+    /// as `PathState::scatter` draws them after the light sample: the lobe number (kept only
+    /// where the BSDF reads it: `Lobe::Unread` leaves its value unused, so the compiler drops
+    /// its hashing while the sampler still moves past it), then the square. Returns the lane.
+    #[inline(always)]
     pub fn push(
         &mut self,
         index: u32,
         path: &PathState,
         p: Vec3,
         light: Option<(LightSample, f32)>,
+        lobe: Lobe,
         rng: &mut Sampler,
     ) -> usize {
         let i = self.len;
@@ -251,7 +261,10 @@ impl SharedColumns {
         self.v.put_ray(i, path.ray.dir, p);
         put3(&mut self.throughput, i, path.throughput().to_array());
         self.ne.put(i, light);
-        self.u_lobe[i] = rng.next_f32();
+        let u_lobe = rng.next_f32();
+        if lobe == Lobe::Read {
+            self.u_lobe[i] = u_lobe;
+        }
         let u = rng.next_2d();
         self.u[0][i] = u[0];
         self.u[1][i] = u[1];

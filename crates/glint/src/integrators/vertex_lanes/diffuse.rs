@@ -3,7 +3,7 @@
 //! shadow ray, the cosine sample and the next ray (`diffuse_lanes`), as
 //! `PathState::scatter` computes them for `Bsdf::Diffuse`.
 
-use super::columns::SharedColumns;
+use super::columns::{Lobe, SharedColumns};
 use super::lane_math::*;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use super::{flag, put3, Column, Column3, MeshHit};
@@ -98,7 +98,7 @@ impl DiffuseChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) -> usize {
-        let i = self.shared.push(path_index, path, p, light, rng);
+        let i = self.shared.push(path_index, path, p, light, Lobe::Unread, rng);
         put3(&mut self.reflectance, i, reflectance.to_array());
         i
     }

@@ -9,7 +9,7 @@
 //! [`Coating`]) is here; the rough coating's kernel (`rough_plastic`) adds its microfacet lobe
 //! and replaces the transmittance `1 - F` by its table.
 
-use super::columns::SharedColumns;
+use super::columns::{Lobe, SharedColumns};
 use super::lane_math::*;
 use super::smooth::fresnel_dielectric;
 use super::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
@@ -48,7 +48,7 @@ impl PlasticChunk {
         rng: &mut Sampler,
     ) {
         debug_assert!(bsdf.dist.is_none(), "rough plastics wait in `RoughPlasticChunk`");
-        let i = self.shared.push(path_index, path, si.p, light, rng);
+        let i = self.shared.push(path_index, path, si.p, light, Lobe::Read, rng);
         self.shared.v.put_frame(i, si.ng, frame);
         self.bsdf.put(i, bsdf);
     }

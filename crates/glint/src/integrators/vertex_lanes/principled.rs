@@ -9,7 +9,7 @@
 //! sample's `sin_cos` and `powf`, GTR1's `ln`) are the scalar code's libm calls, made per
 //! lane ([`per_lane`]): the same call gives the same bits.
 
-use super::columns::SharedColumns;
+use super::columns::{Lobe, SharedColumns};
 use super::lane_math::*;
 use super::microfacet::{ggx_visible_normal_unit, per_lane};
 use super::{put3, Column, Column3};
@@ -58,7 +58,7 @@ impl PrincipledChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.shared.push(path_index, path, si.p, light, rng);
+        let i = self.shared.push(path_index, path, si.p, light, Lobe::Read, rng);
         self.shared.v.put_frame(i, si.ng, frame);
         put3(&mut self.base_color, i, b.base_color.to_array());
         self.roughness[i] = b.roughness;

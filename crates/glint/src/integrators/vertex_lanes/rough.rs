@@ -3,7 +3,7 @@
 //! the shadow ray, then a visible normal (`microfacet`), the reflected direction, its value
 //! and density (`BsdfSample::non_delta`'s rules) and the next ray.
 
-use super::columns::SharedColumns;
+use super::columns::{Lobe, SharedColumns};
 use super::lane_math::*;
 use super::microfacet::{LaneMicrofacet, MicrofacetColumns};
 use super::smooth::fresnel_conductor;
@@ -43,7 +43,7 @@ impl RoughChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.shared.push(path_index, path, si.p, light, rng);
+        let i = self.shared.push(path_index, path, si.p, light, Lobe::Unread, rng);
         self.shared.v.put_frame(i, si.ng, frame);
         self.dist.put(i, &m.dist);
         put3(&mut self.eta, i, m.eta.to_array());

@@ -9,7 +9,7 @@
 //! scalar function's, called once per vertex at `push`; the microfacet's libm calls are
 //! `microfacet`'s per-lane ones. Everything else runs in the vector operations.
 
-use super::columns::SharedColumns;
+use super::columns::{Lobe, SharedColumns};
 use super::lane_math::*;
 use super::microfacet::{LaneMicrofacet, MicrofacetColumns};
 use super::smooth::fresnel_dielectric;
@@ -52,7 +52,7 @@ impl RoughDielectricChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.shared.push(path_index, path, si.p, light, rng);
+        let i = self.shared.push(path_index, path, si.p, light, Lobe::Read, rng);
         self.shared.v.put_frame(i, si.ng, frame);
         self.dist.put(i, &b.dist);
         self.eta[i] = b.eta;

@@ -16,7 +16,7 @@
 //! three times per vertex (at `wo`, towards the light and at the sampled direction), and only
 //! for the lanes that read the result.
 
-use super::columns::SharedColumns;
+use super::columns::{Lobe, SharedColumns};
 use super::lane_math::*;
 use super::microfacet::{per_lane, LaneMicrofacet, MicrofacetColumns};
 use super::plastic::{Coating, PlasticColumns};
@@ -59,7 +59,7 @@ impl RoughPlasticChunk {
         light: Option<(LightSample, f32)>,
         rng: &mut Sampler,
     ) {
-        let i = self.shared.push(path_index, path, si.p, light, rng);
+        let i = self.shared.push(path_index, path, si.p, light, Lobe::Read, rng);
         self.shared.v.put_frame(i, si.ng, frame);
         self.bsdf.put(i, bsdf);
         self.dist.put(i, dist);

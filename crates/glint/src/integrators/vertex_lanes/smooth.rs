@@ -3,7 +3,7 @@
 //! `Bsdf::Dielectric` (the dielectric Fresnel term, reflection or refraction chosen by the
 //! lobe number): no light sample, no shadow ray, the next ray.
 
-use super::columns::SharedColumns;
+use super::columns::{Lobe, SharedColumns};
 use super::lane_math::*;
 use super::{put3, Column, Column3};
 use crate::integrators::path::PathState;
@@ -49,7 +49,7 @@ impl SmoothChunk {
         rng: &mut Sampler,
     ) {
         // A delta BSDF: no light sample.
-        let i = self.shared.push(path_index, path, si.p, None, rng);
+        let i = self.shared.push(path_index, path, si.p, None, Lobe::Read, rng);
         self.shared.v.put_frame(i, si.ng, frame);
         match bsdf {
             Smooth::Conductor(m) => {
