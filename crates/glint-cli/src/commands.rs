@@ -143,8 +143,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "FILE")]
     pub film_out: Option<PathBuf>,
     /// How paths are scheduled: wavefront-simd (a tile's paths advanced together, a bounce at
-    /// a time, shadow rays traced in packets and Lambertian vertices shaded 8 or 16 paths per
-    /// instruction; the default), wavefront (the same, one ray and one vertex at a time),
+    /// a time, shadow rays traced in packets and the common BSDFs' vertices shaded 8 or 16
+    /// paths per instruction; the default), wavefront (the same, one ray and one vertex at a time),
     /// wavefront-interleaved (each batch traced with several rays in flight),
     /// wavefront-packets (shadow rays in packets, vertices one at a time) or one-path (each
     /// path to its end). Same image under each.

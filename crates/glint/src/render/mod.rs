@@ -56,9 +56,10 @@ pub enum Schedule {
     /// occlusion on the bunny and dragon ray sets, 0.8 to 0.9x on the room, about even in
     /// renders (BENCHMARKS.md), so not the default.
     WavefrontPackets,
-    /// As `WavefrontPackets`, the path tracer's Lambertian vertices shaded 8 or 16 paths per
-    /// instruction (`integrators::vertex_lanes`; the other BSDFs one path at a time). The
-    /// default: the fastest measured (BENCHMARKS.md, "The vertex in SIMD lanes").
+    /// As `WavefrontPackets`, the path tracer's vertices of the common BSDFs (Lambertian,
+    /// conductors, dielectrics, plastics, principled) shaded 8 or 16 paths per instruction
+    /// (`integrators::vertex_lanes`; the other BSDFs one path at a time). The default: the
+    /// fastest measured (BENCHMARKS.md, "The vertex in SIMD lanes").
     #[default]
     WavefrontSimd,
 }
