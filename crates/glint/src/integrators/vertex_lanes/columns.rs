@@ -142,7 +142,7 @@ impl NextEventColumns {
         light_only: bool,
     ) {
         let (zero, one) = (l.splat(0.0), l.splat(1.0));
-        let f_black = l.and(l.and(l.eq(f.x, zero), l.eq(f.y, zero)), l.eq(f.z, zero));
+        let f_black = black3(l, f);
         let light_pdf = l.load(&self.light_pdf[base..]);
         // `power_heuristic(light_pdf, bsdf_pdf)`.
         let a = l.mul(light_pdf, light_pdf);
@@ -269,6 +269,23 @@ impl SharedColumns {
         self.u[0][i] = u[0];
         self.u[1][i] = u[1];
         i
+    }
+
+    /// Stores the continuation of the lanes from `base` as the end of `PathState::scatter`
+    /// makes it: the lanes in `kept` whose `weight` is not black (`scatter` ends a path on a
+    /// black weight) go on along `wi` (in the shading frame) from the vertex, the sample's
+    /// density `pdf`. Eta and the delta flag are the kernel's to store where they vary.
+    #[inline(always)]
+    pub fn store_next<L: Lanes>(&mut self, l: L, base: usize, kept: L::M, weight: V3<L::F>, pdf: L::F, wi: V3<L::F>) {
+        let (zero, one) = (l.splat(0.0), l.splat(1.0));
+        let sampled = l.and_not(kept, black3(l, weight));
+        l.store(l.select(sampled, one, zero), &mut self.next.sampled[base..]);
+        store3(l, weight, &mut self.next.weight, base);
+        l.store(pdf, &mut self.next.pdf[base..]);
+        // `frame.to_world(wi)`, then `spawn_ray`.
+        let wi_world = self.v.world(l, base, wi);
+        store3(l, wi_world, &mut self.next.dir, base);
+        store3(l, self.v.spawn_origin(l, base, wi_world), &mut self.next.origin, base);
     }
 
     /// Lane `i`'s shadow ray and continuation into its path, as the end of

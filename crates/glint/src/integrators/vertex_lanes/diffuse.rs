@@ -111,7 +111,6 @@ lane_kernel!(DiffuseChunk, diffuse_lanes);
 fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, _live: u32, light_only: bool) {
     mesh_frames(l, c, base);
     let zero = l.splat(0.0);
-    let one = l.splat(1.0);
     let inv_pi = l.splat(INV_PI);
     let dir = load3(l, &c.shared.v.dir, base);
     let n = load3(l, &c.shared.v.n, base);
@@ -141,16 +140,9 @@ fn diffuse_lanes<L: Lanes>(l: L, c: &mut DiffuseChunk, base: usize, _live: u32, 
     let u1 = l.load(&c.shared.u[1][base..]);
     let d = cosine_hemisphere(l, u0, u1);
     let z = d.z;
-    let refl_black = l.and(l.and(l.eq(refl.x, zero), l.eq(refl.y, zero)), l.eq(refl.z, zero));
-    let sampled = l.and_not(l.and_not(l.not(wo_below), l.le(z, zero)), refl_black);
-    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
-    // `Diffuse::sample`'s weight: the reflectance.
-    store3(l, refl, &mut c.shared.next.weight, base);
-    l.store(cosine_hemisphere_pdf(l, z), &mut c.shared.next.pdf[base..]);
-    // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi = c.shared.v.world(l, base, d);
-    store3(l, wi, &mut c.shared.next.dir, base);
-    store3(l, c.shared.v.spawn_origin(l, base, wi), &mut c.shared.next.origin, base);
+    // `Diffuse::sample`'s weight is the reflectance.
+    let kept = l.and_not(l.not(wo_below), l.le(z, zero));
+    c.shared.store_next(l, base, kept, refl, cosine_hemisphere_pdf(l, z), d);
 }
 
 /// For the lanes of untransformed meshes: `World::interaction`'s geometric normal and

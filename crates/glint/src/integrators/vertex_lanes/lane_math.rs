@@ -114,3 +114,10 @@ pub(super) fn neg3<L: Lanes>(l: L, a: V3<L::F>) -> V3<L::F> {
 pub(super) fn normalize<L: Lanes>(l: L, v: V3<L::F>) -> V3<L::F> {
     scale(l, v, l.div(l.splat(1.0), l.sqrt(dot(l, v, v))))
 }
+
+/// `Rgb::is_black` of a colour in lanes: every channel zero.
+#[inline(always)]
+pub(super) fn black3<L: Lanes>(l: L, v: V3<L::F>) -> L::M {
+    let zero = l.splat(0.0);
+    l.and(l.and(l.eq(v.x, zero), l.eq(v.y, zero)), l.eq(v.z, zero))
+}

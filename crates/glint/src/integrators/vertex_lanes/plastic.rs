@@ -180,15 +180,7 @@ fn plastic_lanes<L: Lanes>(l: L, c: &mut PlasticChunk, base: usize, _live: u32, 
     let below_base = l.and_not(l.le(d.z, zero), mirror);
     let kept = l.and_not(l.not(wo_below), below_base);
     let weight = select3(l, mirror, w_mirror, w_diffuse);
-    // `scatter` ends the path on a black weight too.
-    let w_black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
-    let sampled = l.and_not(kept, w_black);
-    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
+    let pdf = l.select(mirror, coat.ps, pdf_d);
+    c.shared.store_next(l, base, kept, weight, pdf, select3(l, mirror, reflected, d));
     l.store(l.select(mirror, one, zero), &mut c.shared.next.delta[base..]);
-    store3(l, weight, &mut c.shared.next.weight, base);
-    l.store(l.select(mirror, coat.ps, pdf_d), &mut c.shared.next.pdf[base..]);
-    // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi = c.shared.v.world(l, base, select3(l, mirror, reflected, d));
-    store3(l, wi, &mut c.shared.next.dir, base);
-    store3(l, c.shared.v.spawn_origin(l, base, wi), &mut c.shared.next.origin, base);
 }

@@ -156,16 +156,8 @@ fn principled_lanes<L: Lanes>(l: L, c: &mut PrincipledChunk, base: usize, _live:
     ok = l.and(ok, l.gt(pdf, zero));
     let value = b.eval(l, wo, wi);
     let weight = scale(l, value, l.div(one, pdf));
-    // `scatter` drops a black weight.
-    let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
-    let sampled = l.and_not(ok, black);
-    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
-    store3(l, weight, &mut c.shared.next.weight, base);
-    l.store(pdf, &mut c.shared.next.pdf[base..]);
+    c.shared.store_next(l, base, ok, weight, pdf, wi);
     l.store(l.select(pick_trans, fr.eta_ti, one), &mut c.shared.next.eta[base..]);
-    let wi_world = c.shared.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.shared.next.dir, base);
-    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }
 
 /// `Gtr1::sample(u)`: the clearcoat's normal.

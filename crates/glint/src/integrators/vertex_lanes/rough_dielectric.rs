@@ -184,14 +184,6 @@ fn rough_dielectric_lanes<L: Lanes>(l: L, c: &mut RoughDielectricChunk, base: us
     let density = l.and(l.gt(pdf, zero), l.lt(l.abs(pdf), l.splat(f32::INFINITY)));
     let kept = l.and(l.and(facing, lobe_ok), density);
     let weight = scale(l, value, l.div(one, pdf));
-    let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
-    let sampled = l.and_not(kept, black);
-    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
-    store3(l, weight, &mut c.shared.next.weight, base);
-    l.store(pdf, &mut c.shared.next.pdf[base..]);
+    c.shared.store_next(l, base, kept, weight, pdf, wi);
     l.store(l.select(reflect, one, fr.eta_ti), &mut c.shared.next.eta[base..]);
-    // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi_world = c.shared.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.shared.next.dir, base);
-    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }

@@ -143,13 +143,5 @@ fn rough_plastic_lanes<L: Lanes>(l: L, c: &mut RoughPlasticChunk, base: usize, l
     // `value / pdf`, a product by the reciprocal. Then `scatter` ends the path on a black one.
     let kept = l.and(l.and_not(above, l.le(wi.z, zero)), l.gt(pdf, zero));
     let weight = scale(l, value, l.div(one, pdf));
-    let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
-    let sampled = l.and_not(kept, black);
-    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
-    store3(l, weight, &mut c.shared.next.weight, base);
-    l.store(pdf, &mut c.shared.next.pdf[base..]);
-    // `frame.to_world(wi)`, then `spawn_ray`.
-    let wi_world = c.shared.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.shared.next.dir, base);
-    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
+    c.shared.store_next(l, base, kept, weight, pdf, wi);
 }

@@ -106,17 +106,10 @@ fn smooth_lanes<L: Lanes>(l: L, c: &mut SmoothChunk, base: usize, _live: u32, _l
         // `Dielectric::sample` always samples.
         sampled = l.or(glass, l.and(mirror, sampled));
     }
-    let black = l.and(l.and(l.eq(weight.x, zero), l.eq(weight.y, zero)), l.eq(weight.z, zero));
-    let sampled = l.and_not(sampled, black);
-    l.store(l.select(sampled, one, zero), &mut c.shared.next.sampled[base..]);
     // A delta sample of density 1.
-    l.store(one, &mut c.shared.next.pdf[base..]);
+    c.shared.store_next(l, base, sampled, weight, one, wi);
     l.store(one, &mut c.shared.next.delta[base..]);
-    store3(l, weight, &mut c.shared.next.weight, base);
     l.store(eta_out, &mut c.shared.next.eta[base..]);
-    let wi_world = c.shared.v.world(l, base, wi);
-    store3(l, wi_world, &mut c.shared.next.dir, base);
-    store3(l, c.shared.v.spawn_origin(l, base, wi_world), &mut c.shared.next.origin, base);
 }
 
 /// `bsdf::DielectricFresnel` over lanes.
